@@ -1,0 +1,32 @@
+"""Design layer: generic minimax optimisation (never imports the model layer).
+
+``MinimaxProblem`` maps design variables to a vector f_k(x); ``solve`` runs one local method on
+the epigraph NLP; ``multistart`` runs many starts (serially or on dask) into a campaign store.
+"""
+
+from railopt.design.methods import METHODS
+from railopt.design.multistart import distinct_optima, label_clusters, multistart
+from railopt.design.parallel import dask_client, map_unordered
+from railopt.design.problem import Evaluation, MinimaxProblem
+from railopt.design.result import STATUSES, SolveResult
+from railopt.design.solve import solve
+from railopt.design.starts import start_points
+from railopt.design.store import CampaignStore
+from railopt.design.variables import DesignVariable
+
+__all__ = [
+    "METHODS",
+    "STATUSES",
+    "CampaignStore",
+    "DesignVariable",
+    "Evaluation",
+    "MinimaxProblem",
+    "SolveResult",
+    "dask_client",
+    "distinct_optima",
+    "label_clusters",
+    "map_unordered",
+    "multistart",
+    "solve",
+    "start_points",
+]

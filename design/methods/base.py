@@ -1,0 +1,113 @@
+"""What every method shares: the scaled epigraph view of a problem and the method registry.
+
+Solvers work in unit-cube coordinates u (see :class:`~railopt.design.variables.Space`) and on
+the epigraph NLP ``min τ  s.t.  f_k(x(u))/s − τ ≤ 0,  (g_i(x(u)) − ε_i)/s_g ≤ 0,  0 ≤ u ≤ 1``
+with s = max(|U(x0)|, 1) so that τ is of order one whatever the units of f.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+from railopt.design.problem import Evaluation, MinimaxProblem
+
+BIG = 1e12  # stands in for +inf inside solvers (U = inf is reported as inf)
+
+COMMON_OPTIONS: dict[str, Any] = {
+    "xtol": 1e-10,  # on u (unit-cube coordinates)
+    "ftol": 1e-12,  # relative, on τ
+    "maxeval": 3000,
+    "maxtime": 120.0,  # seconds
+}
+
+
+class StopSolve(Exception):
+    """Raised inside a solve to stop it (limit reached or the problem functions raised)."""
+
+    def __init__(self, status: str, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+        self.message = message
+
+
+class EpigraphView:
+    """Scaled, counted, best-point-tracking view of a problem for one solve."""
+
+    def __init__(self, problem: MinimaxProblem, x0: np.ndarray, options: Mapping[str, Any]) -> None:
+        self.problem = problem
+        self.space = problem.space
+        self.options = options
+        self.evaluations = 0
+        self.start_time = time.perf_counter()
+        self.best_x = np.asarray(x0, dtype=float).copy()
+        self.best_merit = np.inf
+        ev0 = self._raw(self.best_x, gradient=False)
+        u0_value = ev0.value
+        self.scale = max(abs(u0_value), 1.0) if np.isfinite(u0_value) else 1.0
+        self.tau0 = min(u0_value / self.scale, BIG) if np.isfinite(u0_value) else BIG
+
+    def _raw(self, x: np.ndarray, gradient: bool) -> Evaluation:
+        if self.evaluations >= self.options["maxeval"]:
+            raise StopSolve("maxeval", f"maxeval={self.options['maxeval']} reached")
+        if time.perf_counter() - self.start_time > self.options["maxtime"]:
+            raise StopSolve("maxtime", f"maxtime={self.options['maxtime']} s reached")
+        try:
+            ev = self.problem.evaluate(x, gradient=gradient)
+        except Exception as exc:  # the user's model failed: keep the best point, report it
+            raise StopSolve("error", f"{type(exc).__name__}: {exc}") from exc
+        self.evaluations += 1
+        violation = self.problem.constraint_violation(x, ev)
+        merit = ev.value if violation <= 1e-9 else np.inf
+        if merit < self.best_merit:
+            self.best_merit = merit
+            self.best_x = np.array(x, dtype=float)
+        return ev
+
+    def evaluate_u(self, u: np.ndarray, gradient: bool) -> tuple[np.ndarray, np.ndarray | None,
+                                                                np.ndarray, np.ndarray | None]:
+        """Scaled f/s and (g − ε)/s with Jacobians in u; inf capped at BIG with zero gradient."""
+        u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
+        x = self.space.to_x(u)
+        ev = self._raw(x, gradient)
+        f = ev.f / self.scale
+        g = (ev.g - np.broadcast_to(self.problem.epsilon, ev.g.shape)) / self.scale
+        df = dg = None
+        if gradient:
+            chain = self.space.dx_du(u)
+            df = ev.df * chain[None, :] / self.scale
+            dg = ev.dg * chain[None, :] / self.scale
+            df[~np.isfinite(f)] = 0.0
+            dg[~np.isfinite(g)] = 0.0
+        f = np.where(np.isfinite(f), f, BIG)
+        g = np.where(np.isfinite(g), g, BIG)
+        return f, df, g, dg
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a method hands back: final u, final epigraph τ, a status key and a message."""
+
+    u: np.ndarray
+    tau: float
+    status: str
+    message: str
+
+
+class Method(Protocol):
+    name: str
+    uses_gradient: bool
+    defaults: Mapping[str, Any]
+
+    def run(self, view: EpigraphView, u0: np.ndarray, options: Mapping[str, Any]) -> Outcome: ...
+
+
+METHODS: dict[str, Method] = {}
+
+
+def register(method: Method) -> Method:
+    METHODS[method.name] = method
+    return method

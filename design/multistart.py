@@ -1,0 +1,141 @@
+"""``multistart``: many local solves from Sobol/LHS/user starts, streamed into a campaign store."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from railopt.design.parallel import map_unordered
+from railopt.design.problem import MinimaxProblem
+from railopt.design.result import SolveResult
+from railopt.design.solve import method_options, solve
+from railopt.design.starts import Start, start_points
+from railopt.design.store import CampaignStore
+
+
+@dataclass(frozen=True)
+class _StartTask:
+    """One start, shipped to a worker (NLopt objects are built there, inside :func:`solve`)."""
+
+    problem: MinimaxProblem
+    start: Start
+    method: str
+    options: dict[str, Any]
+
+    def __call__(self) -> tuple[Start, SolveResult]:
+        return self.start, solve(self.problem, self.start.x0, method=self.method, **self.options)
+
+
+def _run(task: _StartTask) -> tuple[Start, SolveResult]:
+    return task()
+
+
+def multistart(
+    problem: MinimaxProblem,
+    n_starts: int,
+    method: str = "slsqp",
+    seed: int = 0,
+    sampler: str = "sobol",
+    points: Sequence[Sequence[float]] | None = None,
+    client: Any = None,
+    store: CampaignStore | None = None,
+    options: dict[str, Any] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    cluster_xtol: float = 1e-3,
+) -> pd.DataFrame:
+    """Solve from user ``points`` plus ``n_starts`` quasi-random starts; one row per start.
+
+    Parameters
+    ----------
+    problem : MinimaxProblem
+    n_starts : int
+        Number of Sobol/LHS starts (> 0), in addition to ``points``.
+    method : str
+        A registered method (``slsqp``, ``cobyla``, ``slp``).
+    seed : int
+        Seed of the sampler: the same seed gives the same starts.
+    sampler : {"sobol", "lhs"}
+    points : sequence of designs, optional
+        User starts (e.g. the existing suspension), ids 0.. before the sampled ones.
+    client : dask.distributed.Client, optional
+        Runs one task per start; ``None`` runs serially in-process.
+    store : CampaignStore, optional
+        Finished starts already in it are skipped (resume); new ones are committed as they finish.
+    options : dict, optional
+        Solver options (see :func:`railopt.design.solve.solve`).
+    progress : callable(done, total), optional
+        Called after every finished start.
+    cluster_xtol : float
+        Distance (∞-norm in unit-cube coordinates) under which optima count as the same.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Sorted by ``start_id``; columns ``start_id, origin, x0_<var>…, <var>…, value, t, status,
+        message, evaluations, wall_time, solver, seed, constraint_violation, bound_violation,
+        success, cluster``.
+    """
+    method_options(method, options)  # validates method and options before any work is done
+    starts = start_points(problem.space, n_starts, sampler=sampler, seed=seed, points=points)
+    owned = store is None
+    if owned:
+        store = CampaignStore.in_memory(problem.space.names)
+    try:
+        done_ids = store.finished_ids()
+        todo = [s for s in starts if s.start_id not in done_ids]
+        total, done = len(starts), len(starts) - len(todo)
+        if progress is not None:
+            progress(done, total)
+        user_options = dict(options or {})
+        tasks = [_StartTask(problem, s, method, user_options) for s in todo]
+        for start, result in map_unordered(_run, tasks, client=client):
+            store.add_start(start.start_id, start.origin, seed, result)
+            done += 1
+            if progress is not None:
+                progress(done, total)
+        table = store.starts()
+    finally:
+        if owned:
+            store.close()
+    return label_clusters(table, problem, cluster_xtol)
+
+
+def label_clusters(table: pd.DataFrame, problem: MinimaxProblem, xtol: float = 1e-3) -> pd.DataFrame:
+    """Add ``success`` and ``cluster`` columns: successful optima within ``xtol`` share a cluster.
+
+    Clusters are numbered 0, 1, … in order of increasing best U; unsuccessful starts get −1.
+    """
+    table = table.copy()
+    names = list(problem.space.names)
+    table["success"] = (
+        (table["status"] == "converged")
+        & (table["constraint_violation"] <= 1e-6)
+        & (table["bound_violation"] <= 1e-6)
+        & np.isfinite(table["value"].to_numpy(dtype=float))
+    )
+    table["cluster"] = -1
+    reps: list[np.ndarray] = []
+    for idx in table[table["success"]].sort_values(["value", "start_id"]).index:
+        u = problem.space.to_u(table.loc[idx, names].to_numpy(dtype=float))
+        for k, r in enumerate(reps):
+            if np.max(np.abs(u - r)) <= xtol:
+                table.loc[idx, "cluster"] = k
+                break
+        else:
+            reps.append(u)
+            table.loc[idx, "cluster"] = len(reps) - 1
+    return table
+
+
+def distinct_optima(table: pd.DataFrame, problem: MinimaxProblem) -> pd.DataFrame:
+    """One row per cluster: best U, how many starts found it, the best design and its start id."""
+    names = list(problem.space.names)
+    rows = []
+    for k, grp in table[table["cluster"] >= 0].groupby("cluster"):
+        best = grp.sort_values(["value", "start_id"]).iloc[0]
+        rows.append({"cluster": int(k), "value": best["value"], "count": len(grp),
+                     "best_start": int(best["start_id"]), **{n: best[n] for n in names}})
+    return pd.DataFrame(rows, columns=["cluster", "value", "count", "best_start", *names])

@@ -1,0 +1,193 @@
+"""The minimax problem: design variables → a fixed-length vector f_k(x), U(x) = max_k f_k(x).
+
+Thesis eqs. (4.74)-(4.75): ``U(x_opt) = min_x max_k f_k(x)`` subject to bounds on x and,
+optionally, extra constraints ``g(x) ≤ ε`` (ε-constraint trade-offs).  The design layer never
+imports the model layer: ``functions`` is any callable.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from railopt.design.variables import DesignVariable, Space
+
+VectorFunction = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """f (m,), g (p,) and, when asked for, their Jacobians (m, d), (p, d), all in x units."""
+
+    f: np.ndarray
+    g: np.ndarray
+    df: np.ndarray | None = None
+    dg: np.ndarray | None = None
+
+    @property
+    def value(self) -> float:
+        """U(x) = max_k f_k (4.74); +inf when any f_k is not finite."""
+        return float(np.max(self.f)) if np.all(np.isfinite(self.f)) else float("inf")
+
+
+class MinimaxProblem:
+    """min_x max_k f_k(x) over box bounds, optionally subject to g(x) ≤ epsilon.
+
+    Parameters
+    ----------
+    variables : sequence of DesignVariable
+        Names, bounds, scaling.
+    functions : callable
+        ``functions(x) -> (m,)`` array; with ``jacobian=True`` it returns ``(f, df)``.
+    jacobian : callable, True or None
+        ``jacobian(x) -> (m, d)``; ``True`` when ``functions`` returns both; ``None`` for
+        central finite differences.
+    constraints, constraint_jacobian : callable, optional
+        ``g(x) -> (p,)`` and its Jacobian (same conventions as above).
+    epsilon : float or (p,) array
+        Right-hand side of g(x) ≤ ε.
+    fd_step : float
+        Relative finite-difference step (of each variable's range).
+    """
+
+    def __init__(
+        self,
+        variables: Sequence[DesignVariable],
+        functions: VectorFunction,
+        jacobian: VectorFunction | bool | None = None,
+        constraints: VectorFunction | None = None,
+        constraint_jacobian: VectorFunction | bool | None = None,
+        epsilon: float | Sequence[float] = 0.0,
+        fd_step: float = 1e-6,
+    ) -> None:
+        self.space = Space(variables)
+        if not callable(functions):
+            raise ValueError("functions: must be callable, x -> (m,) array")
+        if jacobian is not None and jacobian is not True and not callable(jacobian):
+            raise ValueError("jacobian: must be a callable, True or None")
+        if constraints is not None and not callable(constraints):
+            raise ValueError("constraints: must be callable, x -> (p,) array")
+        self._functions = functions
+        self._jacobian = jacobian
+        self._constraints = constraints
+        self._constraint_jacobian = constraint_jacobian
+        self.epsilon = np.atleast_1d(np.asarray(epsilon, dtype=float))
+        if not np.all(np.isfinite(self.epsilon)):
+            raise ValueError("epsilon: must be finite")
+        self.fd_step = float(fd_step)
+        self.n_functions: int | None = None
+
+    @property
+    def variables(self) -> tuple[DesignVariable, ...]:
+        return self.space.variables
+
+    @property
+    def has_constraints(self) -> bool:
+        return self._constraints is not None
+
+    @property
+    def has_analytic_gradient(self) -> bool:
+        return self._jacobian is not None
+
+    # ------------------------------------------------------------------ evaluation
+    def _f(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        if self._jacobian is True:
+            f, df = self._functions(x)
+        else:
+            f = self._functions(x)
+            df = None
+            if want_grad and callable(self._jacobian):
+                df = self._jacobian(x)
+        f = self._as_vector(f, "functions")
+        if want_grad and df is None:
+            df = self._fd(lambda y: self._as_vector(self._functions(y)[0] if self._jacobian is True
+                                                     else self._functions(y), "functions"), x)
+        if df is not None:
+            df = self._as_jacobian(df, len(f), "jacobian")
+        return f, df
+
+    def _g(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        if self._constraints is None:
+            return np.zeros(0), (np.zeros((0, self.space.dim)) if want_grad else None)
+        if self._constraint_jacobian is True:
+            g, dg = self._constraints(x)
+        else:
+            g = self._constraints(x)
+            dg = self._constraint_jacobian(x) if want_grad and callable(self._constraint_jacobian) else None
+        g = self._as_vector(g, "constraints")
+        if want_grad and dg is None:
+            dg = self._fd(lambda y: self._as_vector(self._constraints(y)[0] if self._constraint_jacobian is True
+                                                     else self._constraints(y), "constraints"), x)
+        if dg is not None:
+            dg = self._as_jacobian(dg, len(g), "constraint_jacobian")
+        return g, dg
+
+    def evaluate(self, x: Sequence[float], gradient: bool = False) -> Evaluation:
+        """Evaluate f (and g) at x; Jacobians when ``gradient`` (analytic or finite differences)."""
+        x = np.asarray(x, dtype=float)
+        f, df = self._f(x, gradient)
+        g, dg = self._g(x, gradient)
+        if self.n_functions is None:
+            self.n_functions = len(f)
+        elif len(f) != self.n_functions:
+            raise ValueError(
+                f"functions: returned {len(f)} values, earlier {self.n_functions}; the count must be fixed"
+            )
+        return Evaluation(f, g, df, dg)
+
+    def value(self, x: Sequence[float]) -> float:
+        """U(x) = max_k f_k(x) (4.74)."""
+        return self.evaluate(x).value
+
+    def constraint_violation(self, x: Sequence[float], evaluation: Evaluation | None = None) -> float:
+        """max(0, max_i g_i(x) − ε_i); 0 without constraints."""
+        ev = evaluation if evaluation is not None else self.evaluate(x)
+        if ev.g.size == 0:
+            return 0.0
+        excess = ev.g - np.broadcast_to(self.epsilon, ev.g.shape)
+        return float(max(0.0, np.max(np.where(np.isfinite(excess), excess, np.inf))))
+
+    # ------------------------------------------------------------------ derivatives
+    def _fd(self, fun: VectorFunction, x: np.ndarray) -> np.ndarray:
+        """Central differences, steps of fd_step × range, one-sided at the bounds."""
+        sp = self.space
+        f0 = fun(x)
+        J = np.zeros((len(f0), sp.dim))
+        for i in range(sp.dim):
+            h = self.fd_step * (sp.upper[i] - sp.lower[i])
+            xp, xm = x.copy(), x.copy()
+            xp[i] = min(x[i] + h, sp.upper[i])
+            xm[i] = max(x[i] - h, sp.lower[i])
+            J[:, i] = (fun(xp) - fun(xm)) / (xp[i] - xm[i])
+        return J
+
+    def gradient_check(self, x: Sequence[float]) -> float:
+        """Largest |analytic − finite-difference| / (|FD| + 1e-8·max|f|) over the Jacobian of f."""
+        if not self.has_analytic_gradient:
+            raise ValueError("jacobian: the problem has no analytic gradient to check")
+        x = np.asarray(x, dtype=float)
+        f, df = self._f(x, True)
+
+        def fun(y: np.ndarray) -> np.ndarray:
+            return self._f(y, False)[0]
+
+        fd = self._fd(fun, x)
+        scale = np.abs(fd) + 1e-8 * max(np.max(np.abs(f)), 1.0)
+        return float(np.max(np.abs(df - fd) / scale))
+
+    # ------------------------------------------------------------------ shape checks
+    @staticmethod
+    def _as_vector(a: object, field: str) -> np.ndarray:
+        v = np.asarray(a, dtype=float)
+        if v.ndim != 1 or v.size == 0:
+            raise ValueError(f"{field}: must return a non-empty 1-D array, got shape {v.shape}")
+        if np.any(np.isnan(v)):
+            raise ValueError(f"{field}: returned NaN (use +inf for an unbounded response)")
+        return v
+
+    def _as_jacobian(self, a: object, m: int, field: str) -> np.ndarray:
+        J = np.asarray(a, dtype=float)
+        if J.shape != (m, self.space.dim):
+            raise ValueError(f"{field}: must return shape ({m}, {self.space.dim}), got {J.shape}")
+        return J

@@ -1,0 +1,78 @@
+"""One result type every method fills, and one table of status codes."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+STATUSES: dict[str, str] = {
+    "converged": "a stopping tolerance (xtol/ftol) was reached",
+    "maxeval": "the evaluation limit was reached; best point kept",
+    "maxtime": "the time limit was reached; best point kept",
+    "roundoff_limited": "NLopt: roundoff errors limited progress; best point kept",
+    "forced_stop": "the run was stopped by a callback; best point kept",
+    "failure": "the solver failed (e.g. SLSQP's iteration limit or a singular QP); best point kept",
+    "error": "the problem functions raised an exception; best point kept",
+}
+SUCCESS_STATUSES = frozenset({"converged"})
+FEASIBILITY_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class SolveResult:
+    """Outcome of one local solve, re-evaluated by railopt (not trusted from the solver).
+
+    Attributes
+    ----------
+    x : (d,) ndarray
+        Final design (the better of the solver's answer and the best point it evaluated).
+    value : float
+        U(x) = max_k f_k(x) re-evaluated at ``x``; +inf for an unbounded response.
+    t : float
+        Epigraph variable at the end of the solve (units of f); ``value − t`` is the slack the
+        solver left.
+    status : str
+        A key of :data:`STATUSES`.
+    message : str
+        Solver detail (exception text, NLopt result code).
+    evaluations : int
+        Number of f evaluations (with or without gradient).
+    wall_time : float
+        Seconds.
+    method : str
+        Registered method name.
+    x0 : (d,) ndarray
+        Start point.
+    constraint_violation : float
+        max(0, g(x) − ε) at ``x``.
+    bound_violation : float
+        Largest bound excess relative to the variable's range.
+    functions : (m,) ndarray
+        f_k(x) at ``x``.
+    """
+
+    x: np.ndarray
+    value: float
+    t: float
+    status: str
+    message: str
+    evaluations: int
+    wall_time: float
+    method: str
+    x0: np.ndarray
+    constraint_violation: float = 0.0
+    bound_violation: float = 0.0
+    functions: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise ValueError(f"status: unknown status {self.status!r}")
+
+    @property
+    def feasible(self) -> bool:
+        return self.constraint_violation <= FEASIBILITY_TOL and self.bound_violation <= FEASIBILITY_TOL
+
+    @property
+    def success(self) -> bool:
+        return self.status in SUCCESS_STATUSES and self.feasible and np.isfinite(self.value)

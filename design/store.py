@@ -1,0 +1,215 @@
+"""The campaign store: one SQLite file per campaign, a versioned schema, a reader returning DataFrames.
+
+Every finished start is committed in its own transaction as it streams back, so a killed
+campaign loses at most the starts that were running; ``--resume`` skips the finished ones.
+``start_id`` is the primary key: a start can never be stored twice.  No pickles: vectors are
+JSON, and the campaign config is stored with its SHA-256 so that a resume with a different
+config is refused.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import json
+import math
+import sqlite3
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+SCHEMA_VERSION = 1
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS campaign (
+    id INTEGER PRIMARY KEY CHECK (id = 1),
+    name TEXT NOT NULL,
+    config_json TEXT NOT NULL,
+    config_hash TEXT NOT NULL,
+    variables_json TEXT NOT NULL,
+    created_utc TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS starts (
+    start_id INTEGER PRIMARY KEY,
+    origin TEXT NOT NULL,
+    x0_json TEXT NOT NULL,
+    x_json TEXT NOT NULL,
+    value REAL,
+    t REAL,
+    status TEXT NOT NULL,
+    message TEXT NOT NULL,
+    evaluations INTEGER NOT NULL,
+    wall_time REAL NOT NULL,
+    solver TEXT NOT NULL,
+    seed INTEGER NOT NULL,
+    constraint_violation REAL NOT NULL,
+    bound_violation REAL NOT NULL,
+    functions_json TEXT NOT NULL,
+    finished_utc TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS checks (
+    start_id INTEGER NOT NULL,
+    name TEXT NOT NULL,
+    value REAL,
+    payload_json TEXT NOT NULL,
+    PRIMARY KEY (start_id, name)
+);
+"""
+
+
+def config_hash(config: Mapping[str, Any]) -> str:
+    """SHA-256 of the canonical JSON of a config mapping."""
+    return hashlib.sha256(json.dumps(config, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def _now() -> str:
+    return _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+
+
+def _num(v: float) -> float | None:
+    """SQLite stores ±inf as REAL but NaN as NULL; keep inf, map NaN to NULL explicitly."""
+    v = float(v)
+    return None if math.isnan(v) else v
+
+
+def _vec(a: Iterable[float]) -> str:
+    return json.dumps([None if math.isnan(float(v)) else (str(float(v)) if math.isinf(float(v)) else float(v))
+                       for v in np.asarray(a, dtype=float).ravel()])
+
+
+def _unvec(s: str) -> np.ndarray:
+    return np.array([float("nan") if v is None else float(v) for v in json.loads(s)], dtype=float)
+
+
+def _initialise(db: sqlite3.Connection, name: str, config: Mapping[str, Any], variables: list[str]) -> None:
+    from railopt import __version__
+
+    with db:
+        db.executescript(_SCHEMA)
+        db.executemany(
+            "INSERT INTO meta VALUES (?, ?)",
+            [("schema_version", str(SCHEMA_VERSION)), ("railopt_version", __version__)],
+        )
+        db.execute(
+            "INSERT INTO campaign VALUES (1, ?, ?, ?, ?, ?)",
+            (name, json.dumps(config, sort_keys=True, default=str), config_hash(config),
+             json.dumps(list(variables)), _now()),
+        )
+
+
+class CampaignStore:
+    """One campaign's SQLite file.  Use :meth:`create` for a new campaign, :meth:`open` to read/resume."""
+
+    def __init__(self, path: Path, connection: sqlite3.Connection) -> None:
+        self.path = Path(path)
+        self._db = connection
+
+    # ------------------------------------------------------------------ opening
+    @classmethod
+    def create(cls, path: str | Path, name: str, config: Mapping[str, Any], variables: list[str]) -> CampaignStore:
+        """Create a new store; refuses to touch an existing file."""
+        path = Path(path)
+        if path.exists():
+            raise FileExistsError(f"store: {path} already exists (resume it, or remove it to start afresh)")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        db = sqlite3.connect(path)
+        try:
+            _initialise(db, name, config, variables)
+        except Exception:
+            db.close()
+            path.unlink(missing_ok=True)
+            raise
+        return cls(path, db)
+
+    @classmethod
+    def in_memory(cls, variables: Sequence[str], name: str = "in-memory") -> CampaignStore:
+        """A throw-away store in memory (multistart without a file uses the same code path)."""
+        db = sqlite3.connect(":memory:")
+        _initialise(db, name, {}, list(variables))
+        return cls(Path(":memory:"), db)
+
+    @classmethod
+    def open(cls, path: str | Path, expect_config: Mapping[str, Any] | None = None) -> CampaignStore:
+        """Open an existing store; with ``expect_config`` refuse one made from another config."""
+        path = Path(path)
+        if not path.exists():
+            raise FileNotFoundError(f"store: {path} does not exist")
+        db = sqlite3.connect(path)
+        store = cls(path, db)
+        version = int(store.meta()["schema_version"])
+        if version != SCHEMA_VERSION:
+            db.close()
+            raise ValueError(f"store: schema version {version} in {path}, this railopt reads {SCHEMA_VERSION}")
+        if expect_config is not None and store.config_hash != config_hash(expect_config):
+            db.close()
+            raise ValueError(f"store: {path} was made from a different config; refusing to resume it")
+        return store
+
+    def close(self) -> None:
+        self._db.close()
+
+    def __enter__(self) -> CampaignStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ------------------------------------------------------------------ writing
+    def add_start(self, start_id: int, origin: str, seed: int, result: Any) -> None:
+        """Record one finished start (a :class:`~railopt.design.result.SolveResult`) atomically."""
+        with self._db:
+            self._db.execute(
+                "INSERT INTO starts VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
+                (int(start_id), origin, _vec(result.x0), _vec(result.x), _num(result.value), _num(result.t),
+                 result.status, result.message, int(result.evaluations), float(result.wall_time), result.method,
+                 int(seed), float(result.constraint_violation), float(result.bound_violation),
+                 _vec(result.functions), _now()),
+            )
+
+    def add_check(self, start_id: int, name: str, value: float, payload: Mapping[str, Any] | None = None) -> None:
+        """Record a check of an optimum (e.g. a critical speed); replaces an earlier one of that name."""
+        with self._db:
+            self._db.execute(
+                "INSERT OR REPLACE INTO checks VALUES (?,?,?,?)",
+                (int(start_id), name, _num(value), json.dumps(payload or {}, sort_keys=True, default=str)),
+            )
+
+    # ------------------------------------------------------------------ reading
+    def meta(self) -> dict[str, str]:
+        return dict(self._db.execute("SELECT key, value FROM meta").fetchall())
+
+    @property
+    def config_hash(self) -> str:
+        return self._db.execute("SELECT config_hash FROM campaign").fetchone()[0]
+
+    def config(self) -> dict[str, Any]:
+        return json.loads(self._db.execute("SELECT config_json FROM campaign").fetchone()[0])
+
+    def variables(self) -> list[str]:
+        return json.loads(self._db.execute("SELECT variables_json FROM campaign").fetchone()[0])
+
+    def finished_ids(self) -> set[int]:
+        return {r[0] for r in self._db.execute("SELECT start_id FROM starts")}
+
+    def starts(self) -> pd.DataFrame:
+        """One row per finished start, sorted by start_id; x0 and x expanded to named columns."""
+        df = pd.read_sql_query("SELECT * FROM starts ORDER BY start_id", self._db)
+        names = self.variables()
+        x0 = np.array([_unvec(s) for s in df["x0_json"]]).reshape(len(df), len(names))
+        x = np.array([_unvec(s) for s in df["x_json"]]).reshape(len(df), len(names))
+        for i, n in enumerate(names):
+            df[f"x0_{n}"] = x0[:, i]
+        for i, n in enumerate(names):
+            df[n] = x[:, i]
+        df["value"] = df["value"].astype(float)
+        df["functions"] = [_unvec(s) for s in df["functions_json"]]
+        return df.drop(columns=["x0_json", "x_json", "functions_json"])
+
+    def checks(self) -> pd.DataFrame:
+        df = pd.read_sql_query("SELECT * FROM checks ORDER BY start_id, name", self._db)
+        df["payload"] = [json.loads(s) for s in df.pop("payload_json")]
+        return df
