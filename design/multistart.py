@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+
 from railopt.design.parallel import map_unordered
 from railopt.design.problem import MinimaxProblem
 from railopt.design.result import SolveResult

@@ -7,9 +7,10 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+
 from railopt.design.methods import METHODS
-from railopt.design.methods.base import COMMON_OPTIONS, EpigraphView
-from railopt.design.problem import MinimaxProblem
+from railopt.design.methods.base import COMMON_OPTIONS, EpigraphView, StopSolve
+from railopt.design.problem import Evaluation, MinimaxProblem
 from railopt.design.result import SolveResult
 
 
@@ -54,27 +55,48 @@ def solve(problem: MinimaxProblem, x0: Sequence[float], method: str = "slsqp", *
     opts = method_options(method, options)
     x0 = problem.space.check_point(x0)
     start = time.perf_counter()
-    view = EpigraphView(problem, x0, opts)
+    try:
+        view = EpigraphView(problem, x0, opts)
+    except StopSolve as stop:  # the model fails at the start point itself
+        return _result(problem, x0, x0, None, np.inf, stop.status, stop.message, 0, start, method)
     outcome = METHODS[method].run(view, problem.space.to_u(x0), opts)
-    x_solver = problem.space.to_x(np.clip(outcome.u, 0.0, 1.0))
-    ev = problem.evaluate(x_solver)
-    x, ev_best = x_solver, ev
-    violation = problem.constraint_violation(x, ev)
-    if np.isfinite(view.best_merit) and (view.best_merit < ev.value or violation > 1e-9):
-        ev_b = problem.evaluate(view.best_x)
-        if problem.constraint_violation(view.best_x, ev_b) <= 1e-9 and ev_b.value < ev.value:
-            x, ev_best = view.best_x, ev_b
+    # re-evaluate ourselves: the solver's point, or the best point it evaluated if that is better
+    candidates = [problem.space.to_x(np.clip(outcome.u, 0.0, 1.0))]
+    if np.isfinite(view.best_merit):
+        candidates.append(view.best_x)
+    best_x, best_ev = candidates[0], None
+    for x in candidates:
+        ev = _safe_evaluate(problem, x)
+        if ev is not None and problem.constraint_violation(x, ev) <= 1e-9 and (
+            best_ev is None or ev.value < best_ev.value
+        ):
+            best_x, best_ev = x, ev
+    if best_ev is None:  # nothing feasible: report the solver's point as it is
+        best_ev = _safe_evaluate(problem, best_x)
+    return _result(problem, x0, best_x, best_ev, outcome.tau, outcome.status, outcome.message,
+                   view.evaluations, start, method)
+
+
+def _safe_evaluate(problem: MinimaxProblem, x: np.ndarray) -> Evaluation | None:
+    try:
+        return problem.evaluate(x)
+    except Exception:  # reported through the status of the solve, which already stopped on it
+        return None
+
+
+def _result(problem: MinimaxProblem, x0: np.ndarray, x: np.ndarray, ev: Evaluation | None, tau: float,
+            status: str, message: str, evaluations: int, start: float, method: str) -> SolveResult:
     return SolveResult(
         x=np.asarray(x, dtype=float),
-        value=ev_best.value,
-        t=float(outcome.tau),
-        status=outcome.status,
-        message=outcome.message,
-        evaluations=view.evaluations,
+        value=ev.value if ev is not None else np.inf,
+        t=float(tau),
+        status=status,
+        message=message,
+        evaluations=evaluations,
         wall_time=time.perf_counter() - start,
         method=method,
         x0=np.asarray(x0, dtype=float),
-        constraint_violation=problem.constraint_violation(x, ev_best),
+        constraint_violation=problem.constraint_violation(x, ev) if ev is not None else np.inf,
         bound_violation=problem.space.bound_violation(x),
-        functions=ev_best.f,
+        functions=ev.f if ev is not None else np.zeros(0),
     )

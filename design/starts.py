@@ -7,8 +7,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from railopt.design.variables import Space
 from scipy.stats import qmc
+
+from railopt.design.variables import Space
 
 SAMPLERS = ("sobol", "lhs")
 

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+
 from railopt.design.problem import MinimaxProblem
 from railopt.design.variables import DesignVariable
 

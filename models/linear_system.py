@@ -9,6 +9,7 @@ differentiated ``q`` times in time (``q = 0, 1, 2`` for displacement, velocity, 
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -16,6 +17,8 @@ import numpy as np
 import scipy.linalg as sla
 
 RESPONSE_ORDER = {"displacement": 0, "velocity": 1, "acceleration": 2}
+SINGULAR_PIVOT = 1e-14  # relative LU pivot below which Z(Ω) counts as singular (response = inf)
+UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
 
 ForcingLike = np.ndarray | Sequence[complex] | Callable[[float], np.ndarray]
 
@@ -79,6 +82,16 @@ def as_forcing(F: ForcingLike | Forcing, n: int) -> Forcing:
     return forcing
 
 
+def mode_order(s: np.ndarray) -> np.ndarray:
+    """Order of 2n roots by |Im s| then Re s; every second entry ([1::2]) is one root per mode.
+
+    Sorting by |Im s| puts each conjugate pair side by side; real (overdamped) roots also pair
+    up, each pair counting as one mode with ω_d = 0, so the count is always n, as the clipping
+    rule of SPEC §2.4 needs.
+    """
+    return np.lexsort((s.real, np.abs(s.imag)))
+
+
 class LinearSystem:
     """A forced linear system ``M x'' + C x' + K x = F(Ω) e^{iΩt}`` with one scalar output.
 
@@ -124,12 +137,25 @@ class LinearSystem:
         self.names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(n))
         if len(self.names) != n:
             raise ValueError(f"names: expected {n} names, got {len(self.names)}")
+        self._prepare()
+
+    @classmethod
+    def _trusted(cls, M: np.ndarray, C: np.ndarray, K: np.ndarray, forcing: Forcing, output: np.ndarray,
+                 response: str, names: tuple[str, ...]) -> LinearSystem:
+        """Fast path for parametric updates: inputs already validated (finite, shapes), only M re-checked."""
+        self = cls.__new__(cls)
+        self.M, self.C, self.K, self.forcing, self.output = M, C, K, forcing, output
+        self.response, self.order, self.names = response, RESPONSE_ORDER[response], names
+        self._prepare()
+        return self
+
+    def _prepare(self) -> None:
+        """M⁻¹[K C] for the state matrix (4.53); a singular M is an error naming the field."""
         try:
-            self._m_lu = sla.lu_factor(self.M, check_finite=False)
-        except (ValueError, np.linalg.LinAlgError) as exc:  # pragma: no cover - lu_factor warns
-            raise ValueError(f"M: cannot be factorised ({exc})") from exc
-        if np.any(np.abs(np.diag(self._m_lu[0])) <= 1e-300):
-            raise ValueError("M: is singular (a coordinate without inertia); eliminate it first")
+            self._minv_kc = np.linalg.solve(self.M, np.hstack([self.K, self.C]))
+        except np.linalg.LinAlgError as exc:
+            raise ValueError("M: is singular (a coordinate without inertia); eliminate it first") from exc
+        self._eigvals: np.ndarray | None = None
         self._eig: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
@@ -143,8 +169,7 @@ class LinearSystem:
         n = self.n
         G = np.zeros((2 * n, 2 * n))
         G[:n, n:] = np.eye(n)
-        G[n:, :n] = -sla.lu_solve(self._m_lu, self.K)
-        G[n:, n:] = -sla.lu_solve(self._m_lu, self.C)
+        G[n:, :] = -self._minv_kc
         return G
 
     def eigen(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -154,26 +179,26 @@ class LinearSystem:
             self._eig = (s, vl, vr)
         return self._eig
 
-    def _sorted_order(self) -> np.ndarray:
-        s = self.eigen()[0]
-        return np.lexsort((s.real, np.abs(s.imag)))
+    def _roots(self) -> np.ndarray:
+        """All 2n eigenvalues of G, unsorted, cached (vectors are computed only when asked for)."""
+        if self._eigvals is None:
+            self._eigvals = self._eig[0] if self._eig is not None else np.linalg.eigvals(self.state_matrix())
+        return self._eigvals
 
     def eigenvalues(self) -> np.ndarray:
         """The 2n roots ``s_j = μ_j ± iω_dj`` of (4.58), sorted by |Im s| then Re s."""
-        return self.eigen()[0][self._sorted_order()]
-
-    def mode_indices(self) -> np.ndarray:
-        """Indices into ``eigen()[0]`` of one root per mode (n of them).
-
-        Sorting the 2n roots by |Im s| puts each conjugate pair side by side; real (overdamped)
-        roots also pair up, each pair counting as one mode with ω_d = 0, so the count is always
-        n, as the clipping rule of SPEC §2.4 needs.
-        """
-        return self._sorted_order()[1::2]
+        s = self._roots()
+        return s[mode_order(s)]
 
     def mode_roots(self) -> np.ndarray:
-        """One root per mode, n values, in ascending order of ω_d = |Im s|."""
-        return self.eigen()[0][self.mode_indices()]
+        """One root per mode, n values, in ascending order of ω_d = |Im s| (see :func:`mode_order`)."""
+        s = self._roots()
+        return s[mode_order(s)[1::2]]
+
+    def undamped_modes(self) -> np.ndarray:
+        """Boolean (n,): modes whose root lies on the imaginary axis to rounding (|Re s| ≤ 1e-12 |s|)."""
+        s = self.mode_roots()
+        return (np.abs(s.real) <= UNDAMPED_ROOT * np.abs(s)) & (s.imag != 0)
 
     def damped_frequencies(self) -> np.ndarray:
         """Damped natural frequencies ω_dj (rad/s), n values sorted ascending (eq. 4.58)."""
@@ -181,7 +206,7 @@ class LinearSystem:
 
     def is_stable(self, tol: float = 0.0) -> bool:
         """True when every root has Re s ≤ tol (eq. 4.59)."""
-        return bool(np.all(self.eigen()[0].real <= tol))
+        return bool(np.all(self._roots().real <= tol))
 
     # ------------------------------------------------------------------ frequency response (4.69)
     def impedance(self, omega: float) -> np.ndarray:
@@ -193,10 +218,13 @@ class LinearSystem:
         Z = self.impedance(omega)
         F = np.asarray(self.forcing.value(omega), dtype=complex)
         try:
-            lu = sla.lu_factor(Z, check_finite=False)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", sla.LinAlgWarning)
+                lu = sla.lu_factor(Z, check_finite=False)
         except (ValueError, np.linalg.LinAlgError):
             return np.full(self.n, np.inf + 0j)
-        if np.any(np.abs(np.diag(lu[0])) == 0.0):
+        pivots = np.abs(np.diag(lu[0]))
+        if np.min(pivots) <= SINGULAR_PIVOT * np.max(pivots):
             return np.full(self.n, np.inf + 0j)
         return sla.lu_solve(lu, F, check_finite=False)
 

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
-from railopt.models.linear_system import Forcing, ForcingLike, LinearSystem, as_forcing
+
+from railopt.models.linear_system import Forcing, ForcingLike, LinearSystem, as_forcing, mode_order
 from railopt.models.response_maxima import ResponseMaxima, response_maxima, validate_band
 
 
@@ -111,14 +112,15 @@ class ParametricSystem:
         """The :class:`LinearSystem` for parameter vector ``p`` (no re-assembly)."""
         p = self._check(p)
         b = self._base
-        return LinearSystem(
-            b.M + np.tensordot(p, self._M, axes=1),
-            b.C + np.tensordot(p, self._C, axes=1),
-            b.K + np.tensordot(p, self._K, axes=1),
+        n = b.n
+        return LinearSystem._trusted(
+            b.M + (p @ self._M.reshape(len(p), -1)).reshape(n, n),
+            b.C + (p @ self._C.reshape(len(p), -1)).reshape(n, n),
+            b.K + (p @ self._K.reshape(len(p), -1)).reshape(n, n),
             self._forcing(p),
             b.output,
-            response=b.response,
-            names=b.names,
+            b.response,
+            b.names,
         )
 
     def response_maxima(self, p: Sequence[float], band: tuple[float, float], exact: bool = False) -> ResponseMaxima:
@@ -133,16 +135,14 @@ class ParametricSystem:
 
     def _dwd(self, sys: LinearSystem) -> np.ndarray:
         s, vl, vr = sys.eigen()
-        idx = sys.mode_indices()
+        idx = mode_order(s)[1::2]
         n = sys.n
-        lu = sys._m_lu
-        A = sla.lu_solve(lu, sys.K)
-        B = sla.lu_solve(lu, sys.C)
+        AB = sys._minv_kc  # [M⁻¹K, M⁻¹C]
         out = np.zeros((len(idx), len(self.parameters)))
         for i in range(len(self.parameters)):
+            # d(M⁻¹K)/dp = M⁻¹(K_p − M_p M⁻¹K), likewise for C
             Gp = np.zeros((2 * n, 2 * n))
-            Gp[n:, :n] = -sla.lu_solve(lu, self._K[i] - self._M[i] @ A)
-            Gp[n:, n:] = -sla.lu_solve(lu, self._C[i] - self._M[i] @ B)
+            Gp[n:, :] = -np.linalg.solve(sys.M, np.hstack([self._K[i], self._C[i]]) - self._M[i] @ AB)
             for j, k in enumerate(idx):
                 if s[k].imag == 0.0:
                     continue  # overdamped: ω_d ≡ 0

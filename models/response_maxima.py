@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from railopt.models.linear_system import LinearSystem
 from scipy.optimize import minimize_scalar
+
+from railopt.models.linear_system import UNDAMPED_ROOT, LinearSystem
 
 GRID_FACTOR = 0.25  # max grid step / distance to nearest pole
 CERTIFIED_RATIO = GRID_FACTOR / (1 - GRID_FACTOR)
@@ -115,12 +116,16 @@ def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool
     wd = system.damped_frequencies()
     clipped = np.clip(wd, lo, hi)
     edges = np.array([lo, hi])
+    # an undamped mode inside the band has an unbounded peak, whatever rounding makes of Z(ω_d)
+    resonant = system.undamped_modes() & (wd >= lo) & (wd <= hi)
     if not exact:
         freqs = np.concatenate([clipped, edges])
         vals = _finite_or_inf(np.abs(system.frf(freqs)))
+        vals[: len(wd)][resonant] = np.inf
         return ResponseMaxima(vals, freqs, wd, (lo, hi), exact=False)
 
-    poles = system.eigen()[0]
+    poles = system.eigenvalues()
+    poles = poles[np.abs(poles.real) > UNDAMPED_ROOT * np.abs(poles)]  # their cells are inf anyway
     grid = band_grid(poles, (lo, hi), max_delay=system.forcing.max_delay, extra=clipped)
     mags = _finite_or_inf(np.abs(system.frf(grid)))
     bounds = np.concatenate([[lo], 0.5 * (clipped[1:] + clipped[:-1]), [hi]])
@@ -128,6 +133,8 @@ def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool
     cell_freqs = np.empty(len(wd))
     for j in range(len(wd)):
         cell_vals[j], cell_freqs[j] = _cell_maximum(system, grid, mags, bounds[j], bounds[j + 1])
+    cell_vals[resonant] = np.inf
+    cell_freqs[resonant] = clipped[resonant]
     edge_vals = _finite_or_inf(np.abs(system.frf(edges)))
     vals = np.concatenate([cell_vals, edge_vals])
     freqs = np.concatenate([cell_freqs, edges])
@@ -144,6 +151,8 @@ def _finite_or_inf(a: np.ndarray) -> np.ndarray:
 
 def _step_limit(omega: np.ndarray, poles: np.ndarray, max_delay: float) -> np.ndarray:
     """Largest admissible grid step at each Ω: GRID_FACTOR × distance to the nearest pole."""
+    if poles.size == 0:
+        return np.full(np.atleast_1d(omega).shape, np.inf)
     dist = np.min(np.abs(1j * np.atleast_1d(omega)[:, None] - poles[None, :]), axis=1)
     step = GRID_FACTOR * dist
     if max_delay > 0:

@@ -20,8 +20,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from railopt.models.parametric import ParameterPart, ParametricSystem
 from scipy.optimize import minimize_scalar
+
+from railopt.models.parametric import ParameterPart, ParametricSystem
 
 
 @dataclass(frozen=True)

@@ -8,12 +8,27 @@ only when the run succeeds, so a failed run leaves nothing half-written.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
 import pandas as pd
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
+
+
+def _ordered_interval(v: tuple[float, float]) -> tuple[float, float]:
+    lo, hi = v
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ValueError(f"must be finite, got ({lo}, {hi})")
+    if not lo < hi:
+        raise ValueError(f"inverted or empty: lower {lo} ≥ upper {hi}")
+    return v
+
+
+Interval = Annotated[tuple[float, float], AfterValidator(_ordered_interval)]
+"""A (lower, upper) pair with lower < upper, both finite: bounds and frequency bands in configs."""
 
 
 class StrictModel(BaseModel):

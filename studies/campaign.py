@@ -8,10 +8,11 @@ from typing import Any, Literal
 
 import pandas as pd
 from pydantic import Field, field_validator
+from tqdm import tqdm
+
 from railopt.design import CampaignStore, MinimaxProblem, multistart
 from railopt.design.solve import method_options
 from railopt.studies.base import StrictModel, StudyContext
-from tqdm import tqdm
 
 
 class SolverOptions(StrictModel):

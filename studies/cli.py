@@ -13,11 +13,10 @@ import shutil
 import sys
 from pathlib import Path
 
+from railopt import __version__
 from railopt.studies.base import StudyContext
 from railopt.studies.config import ConfigError, load_study
 from railopt.studies.report import markdown_table
-
-from railopt import __version__
 
 STUDIES_DIR = Path(__file__).resolve().parent
 EXIT_USAGE = 2

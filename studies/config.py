@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel, ValidationError
+
 from railopt.studies.base import StudyKind
 
 # kind name -> "module:attribute" of its StudyKind, imported on demand

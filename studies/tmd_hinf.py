@@ -15,7 +15,8 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator
+
 from railopt.design import DesignVariable, MinimaxProblem, distinct_optima
 from railopt.models.tmd import (
     amplification,
@@ -26,6 +27,7 @@ from railopt.models.tmd import (
     tmd_system,
 )
 from railopt.studies.base import (
+    Interval,
     StrictModel,
     StudyContext,
     StudyHeader,
@@ -41,22 +43,27 @@ class TMDModel(StrictModel):
     mass_ratios: list[float] = Field(default=[0.05, 0.1], min_length=1)
     primary_mass_kg: float = Field(1000.0, gt=0)
     primary_frequency_hz: float = Field(2.0, gt=0)
-    band_ratio: tuple[float, float] = (0.5, 1.5)  # band in multiples of the primary natural frequency
+    band_ratio: Interval = (0.5, 1.5)  # band in multiples of the primary natural frequency
 
-    @model_validator(mode="after")
-    def _check(self) -> TMDModel:
-        for i, mu in enumerate(self.mass_ratios):
+    @field_validator("mass_ratios")
+    @classmethod
+    def _positive(cls, v: list[float]) -> list[float]:
+        for i, mu in enumerate(v):
             if not (np.isfinite(mu) and mu > 0):
-                raise ValueError(f"model.mass_ratios[{i}]: must be positive, got {mu}")
-        lo, hi = self.band_ratio
-        if not (0 <= lo < hi):
-            raise ValueError(f"model.band_ratio: empty or inverted band ({lo}, {hi})")
-        return self
+                raise ValueError(f"mass_ratios[{i}] must be positive, got {mu}")
+        return v
+
+    @field_validator("band_ratio")
+    @classmethod
+    def _non_negative(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if v[0] < 0:
+            raise ValueError(f"lower edge must be ≥ 0, got {v[0]}")
+        return v
 
 
 class TMDDesign(CampaignSettings):
-    tuning_bounds: tuple[float, float] = (0.5, 1.5)
-    damping_ratio_bounds: tuple[float, float] = (0.01, 0.5)
+    tuning_bounds: Interval = (0.5, 1.5)
+    damping_ratio_bounds: Interval = (0.01, 0.5)
     objectives: list[Literal["thesis", "exact"]] = Field(default=["thesis", "exact"], min_length=1)
     start_from_den_hartog: bool = True
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
+
 from railopt.design.problem import Evaluation, MinimaxProblem
 
 BIG = 1e12  # stands in for +inf inside solvers (U = inf is reported as inf)

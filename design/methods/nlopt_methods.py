@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
 from railopt.design.methods.base import BIG, EpigraphView, Outcome, StopSolve, register
 
 _RESULT_STATUS = {

@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from railopt.design.methods.base import EpigraphView, Outcome, StopSolve, register
+
+from railopt.design.methods.base import BIG, EpigraphView, Outcome, StopSolve, register
 
 
 def _merit(f: np.ndarray, g: np.ndarray, penalty: float) -> float:
@@ -28,7 +29,7 @@ class SLPMethod:
     name: str = "slp"
     uses_gradient: bool = True
     defaults: Mapping[str, Any] = field(
-        default_factory=lambda: {"initial_radius": 0.1, "penalty": 1e3, "lp_solver": "CLARABEL"}
+        default_factory=lambda: {"initial_radius": 0.1, "penalty": 1e3, "lp_solver": "HIGHS"}
     )
 
     def run(self, view: EpigraphView, u0: np.ndarray, options: Mapping[str, Any]) -> Outcome:
@@ -55,6 +56,8 @@ class SLPMethod:
         try:
             f, df, g, dg = view.evaluate_u(u, gradient=True)
             phi = _merit(f, g, penalty)
+            if phi >= BIG:
+                return Outcome(u, np.inf, "failure", "U = inf at the start (undamped or singular response)")
             while True:
                 fp.value, Jp.value, up.value, radius.value = f, df, u, delta
                 if p:
