@@ -12,6 +12,8 @@ from railopt.design.result import STATUSES, SolveResult
 from railopt.design.solve import solve
 from railopt.design.starts import start_points
 from railopt.design.store import CampaignStore
+from railopt.design.surface import Surface, objective_surface
+from railopt.design.tradeoff import epsilon_sweep, nondominated
 from railopt.design.variables import DesignVariable
 
 __all__ = [
@@ -22,11 +24,15 @@ __all__ = [
     "Evaluation",
     "MinimaxProblem",
     "SolveResult",
+    "Surface",
     "dask_client",
+    "epsilon_sweep",
     "distinct_optima",
     "label_clusters",
     "map_unordered",
     "multistart",
+    "nondominated",
+    "objective_surface",
     "solve",
     "start_points",
 ]

@@ -79,6 +79,11 @@ class MinimaxProblem:
         self.fd_step = float(fd_step)
         self.n_functions: int | None = None
 
+    def with_epsilon(self, epsilon: float | Sequence[float]) -> MinimaxProblem:
+        """The same problem with another right-hand side ε of g(x) ≤ ε (ε-constraint sweeps)."""
+        return MinimaxProblem(self.variables, self._functions, self._jacobian, self._constraints,
+                              self._constraint_jacobian, epsilon, self.fd_step)
+
     @property
     def variables(self) -> tuple[DesignVariable, ...]:
         return self.space.variables

@@ -1,0 +1,132 @@
+"""Figures of the track studies (Figs 3.3–3.9 style).  These functions only draw data they are given.
+
+Deflection is plotted positive downward (the rail sinks under the wheel), distance along the track
+with the load at 0, ahead to the right.  ``units="inch-pound"`` shows inches (the thesis's units),
+``"SI"`` shows metres and millimetres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from railopt.models.track.units import INCH
+
+_UNITS = ("inch-pound", "SI")
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One curve: label, abscissa (m or s), deflection (m), and a matplotlib style."""
+
+    label: str
+    x: np.ndarray
+    y: np.ndarray
+    style: str = "-"
+
+
+def _scales(units: str) -> tuple[float, str, float, str]:
+    if units not in _UNITS:
+        raise ValueError(f"units must be one of {_UNITS}, got {units!r}")
+    if units == "inch-pound":
+        return 1.0 / INCH, "in", 1.0 / INCH, "in"
+    return 1.0, "m", 1000.0, "mm"
+
+
+def _caption(fig: Figure, note: str) -> None:
+    """Parameters as a caption under the axes."""
+    if note:
+        fig.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=7, color="0.3")
+        fig.tight_layout(rect=(0.0, 0.07, 1.0, 1.0))
+    else:
+        fig.tight_layout()
+
+
+def plot_profiles(curves: Sequence[Curve], title: str, units: str = "inch-pound", note: str = "") -> Figure:
+    """Deflection profiles y(ξ) against ξ = x − vt (figs 3.5–3.9 and the accelerating load).
+
+    Parameters
+    ----------
+    curves : sequence of Curve
+        ``x`` is ξ in m, ``y`` the deflection in m.
+    title : str
+        Figure title.
+    units : {"inch-pound", "SI"}
+        Display units.
+    note : str
+        Text placed in the lower right corner (parameters).
+    """
+    sx, ux, sy, uy = _scales(units)
+    fig = Figure(figsize=(7.0, 4.6))
+    ax = fig.subplots()
+    for c in curves:
+        ax.plot(np.asarray(c.x) * sx, np.asarray(c.y) * sy, c.style, label=c.label, lw=1.4)
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.axvline(0.0, color="0.4", lw=0.8, ls=":")
+    ax.invert_yaxis()
+    ax.annotate(
+        "P",
+        xy=(0.0, 0.86),
+        xycoords=("data", "axes fraction"),
+        xytext=(0.0, 0.985),
+        textcoords=("data", "axes fraction"),
+        ha="center",
+        va="top",
+        arrowprops={"arrowstyle": "->"},
+    )
+    ax.set_xlabel(f"distance from the load ξ = x − vt ({ux})   ← behind | ahead →")
+    ax.set_ylabel(f"deflection ({uy}, downward)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=8, loc="best")
+    _caption(fig, note)
+    return fig
+
+
+def plot_time_histories(
+    curves: Sequence[Curve],
+    title: str,
+    units: str = "inch-pound",
+    reference: float | None = None,
+    reference_label: str = "",
+    note: str = "",
+    time_unit: str = "ms",
+) -> Figure:
+    """Deflection at a point against time (figs 3.3 and 3.4); ``x`` of each curve is t in s."""
+    _, _, sy, uy = _scales(units)
+    st = 1000.0 if time_unit == "ms" else 1.0
+    fig = Figure(figsize=(7.0, 4.6))
+    ax = fig.subplots()
+    for c in curves:
+        ax.plot(np.asarray(c.x) * st, np.asarray(c.y) * sy, c.style, label=c.label, lw=1.2, ms=4)
+    if reference is not None:
+        ax.axhline(reference * sy, color="k", ls="--", lw=0.9, label=reference_label)
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_xlabel(f"time after loading ({time_unit})")
+    ax.set_ylabel(f"deflection under the load ({uy}, downward)")
+    ax.invert_yaxis()
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=8)
+    _caption(fig, note)
+    return fig
+
+
+def plot_amplification(
+    speed_ratio: np.ndarray, curves: Sequence[tuple[str, np.ndarray]], title: str
+) -> Figure:
+    """Dynamic amplification y_max / y_static against v/v_cr for several damping ratios."""
+    fig = Figure(figsize=(7.0, 4.2))
+    ax = fig.subplots()
+    for label, amp in curves:
+        ax.plot(speed_ratio, np.minimum(amp, 1e3), label=label, lw=1.3)
+    ax.set_xlabel("speed ratio v / v_cr")
+    ax.set_ylabel("y_max / y_static")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,52 @@
+"""ε-constraint sweeps, non-dominated filtering and objective surfaces against closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from railopt.design import DesignVariable, MinimaxProblem
+from railopt.design.surface import objective_surface
+from railopt.design.tradeoff import epsilon_sweep, nondominated
+
+
+def test_nondominated_matches_brute_force_definition():
+    rng = np.random.default_rng(4)
+    df = pd.DataFrame(rng.uniform(size=(60, 2)), columns=["a", "b"])
+    mask = nondominated(df, ["a", "b"])
+    for i in range(len(df)):
+        dominated = any((df.a[j] <= df.a[i]) and (df.b[j] <= df.b[i]) and (df.a[j] < df.a[i] or df.b[j] < df.b[i])
+                        for j in range(len(df)))
+        assert mask[i] == (not dominated)
+    flipped = nondominated(df.assign(b=-df.b), ["a", "b"], sense={"b": "max"})
+    pd.testing.assert_series_equal(mask, flipped)
+
+
+def test_epsilon_sweep_traces_the_closed_form_tradeoff():
+    """min max(x1, x2... ): U = (x−2)², g = x²  ⇒  optimum x = min(2, √ε), U = (x−2)²."""
+    v = [DesignVariable("x", 0.0, 3.0)]
+    problem = MinimaxProblem(v, lambda x: np.array([(x[0] - 2) ** 2]), constraints=lambda x: np.array([x[0] ** 2]))
+    eps = [0.25, 1.0, 2.25, 9.0]
+    table = epsilon_sweep(problem, eps, n_starts=3, seed=1)
+    xs = np.minimum(2.0, np.sqrt(eps))
+    np.testing.assert_allclose(table["x"], xs, atol=1e-6)
+    np.testing.assert_allclose(table["value"], (xs - 2) ** 2, atol=1e-6)
+    assert table["success"].all()
+    assert nondominated(table, ["value", "g"]).all()  # a trade-off curve: every point is Pareto-optimal
+    worse = pd.concat([table, pd.DataFrame({"value": [1.5], "g": [1.5]})], ignore_index=True)
+    assert list(nondominated(worse, ["value", "g"])) == [True] * 4 + [False]  # (1.5, 1.5) is dominated by (1, 1)
+
+
+def test_surface_values_and_bounds_mask():
+    v = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0), DesignVariable("c", 0.0, 1.0)]
+    problem = MinimaxProblem(v, lambda x: np.array([x[0] + 2 * x[1] + x[2], -x[0]]))
+    xi, xj = np.linspace(-0.5, 1.0, 7), np.linspace(0.0, 2.0, 5)
+    s = objective_surface(problem, ("a", "b"), xi, xj, base=[0.5, 0.5, 0.1])
+    A, B = np.meshgrid(xi, xj)
+    np.testing.assert_allclose(s.values, np.maximum(A + 2 * B + 0.1, -A))
+    assert s.inside.sum() == (xi >= 0).sum() * (xj <= 1).sum()
+    assert s.minimum() == {"a": 0.0, "b": 0.0, "U": 0.1}
+    assert s.minimum(inside_only=False)["U"] == pytest.approx(np.min(np.maximum(A + 2 * B + 0.1, -A)))
+    with pytest.raises(ValueError, match="^names:"):
+        objective_surface(problem, ("a", "z"), xi, xj, base=[0.5, 0.5, 0.1])
