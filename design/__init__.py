@@ -4,6 +4,7 @@
 the epigraph NLP; ``multistart`` runs many starts (serially or on dask) into a campaign store.
 """
 
+from railopt.design.checks import check_designs
 from railopt.design.methods import METHODS
 from railopt.design.multistart import distinct_optima, label_clusters, multistart
 from railopt.design.parallel import dask_client, map_unordered
@@ -25,6 +26,7 @@ __all__ = [
     "MinimaxProblem",
     "SolveResult",
     "Surface",
+    "check_designs",
     "dask_client",
     "epsilon_sweep",
     "distinct_optima",

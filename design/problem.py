@@ -97,37 +97,29 @@ class MinimaxProblem:
         return self._jacobian is not None
 
     # ------------------------------------------------------------------ evaluation
-    def _f(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
-        if self._jacobian is True:
-            f, df = self._functions(x)
+    def _vector(self, fun: VectorFunction, jac: VectorFunction | bool | None, x: np.ndarray, want_grad: bool,
+                field: str, jac_field: str) -> tuple[np.ndarray, np.ndarray | None]:
+        """Value of ``fun`` at x and, when asked, its Jacobian (supplied, returned with it, or FD)."""
+        if jac is True:
+            v, dv = fun(x)
         else:
-            f = self._functions(x)
-            df = None
-            if want_grad and callable(self._jacobian):
-                df = self._jacobian(x)
-        f = self._as_vector(f, "functions")
-        if want_grad and df is None:
-            df = self._fd(lambda y: self._as_vector(self._functions(y)[0] if self._jacobian is True
-                                                     else self._functions(y), "functions"), x)
-        if df is not None:
-            df = self._as_jacobian(df, len(f), "jacobian")
-        return f, df
+            v = fun(x)
+            dv = jac(x) if want_grad and callable(jac) else None
+        v = self._as_vector(v, field)
+        if want_grad and dv is None:
+            dv = self._fd(lambda y: self._as_vector(fun(y)[0] if jac is True else fun(y), field), x)
+        if dv is not None:
+            dv = self._as_jacobian(dv, len(v), jac_field)
+        return v, dv
+
+    def _f(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        return self._vector(self._functions, self._jacobian, x, want_grad, "functions", "jacobian")
 
     def _g(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
         if self._constraints is None:
             return np.zeros(0), (np.zeros((0, self.space.dim)) if want_grad else None)
-        if self._constraint_jacobian is True:
-            g, dg = self._constraints(x)
-        else:
-            g = self._constraints(x)
-            dg = self._constraint_jacobian(x) if want_grad and callable(self._constraint_jacobian) else None
-        g = self._as_vector(g, "constraints")
-        if want_grad and dg is None:
-            dg = self._fd(lambda y: self._as_vector(self._constraints(y)[0] if self._constraint_jacobian is True
-                                                     else self._constraints(y), "constraints"), x)
-        if dg is not None:
-            dg = self._as_jacobian(dg, len(g), "constraint_jacobian")
-        return g, dg
+        return self._vector(self._constraints, self._constraint_jacobian, x, want_grad, "constraints",
+                            "constraint_jacobian")
 
     def evaluate(self, x: Sequence[float], gradient: bool = False) -> Evaluation:
         """Evaluate f (and g) at x; Jacobians when ``gradient`` (analytic or finite differences)."""

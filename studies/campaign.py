@@ -10,7 +10,8 @@ import pandas as pd
 from pydantic import Field, field_validator
 from tqdm import tqdm
 
-from railopt.design import CampaignStore, MinimaxProblem, multistart
+from railopt.design import CampaignStore, MinimaxProblem, check_designs, distinct_optima, multistart
+from railopt.design.checks import Check
 from railopt.design.solve import method_options
 from railopt.studies.base import StrictModel, StudyContext
 
@@ -95,3 +96,19 @@ def run_campaign(
     finally:
         bar.close()
         store.close()
+
+
+def check_optima(
+    problem: MinimaxProblem,
+    table: pd.DataFrame,
+    label: str,
+    context: StudyContext,
+    name: str,
+    check: Check,
+    client: Any = None,
+) -> pd.DataFrame:
+    """Run ``check`` on the best design of each distinct optimum; results go to the campaign's store."""
+    optima = distinct_optima(table, problem).rename(columns={"best_start": "start_id"})
+    with CampaignStore.open(store_path(context, label)) as store:
+        checks = check_designs(check, optima, list(problem.space.names), name, client=client, store=store)
+    return optima.merge(checks, on="start_id", suffixes=("", f"_{name}"))

@@ -114,8 +114,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="dask worker processes of the embedded LocalCluster (default: CPU count; 0 = serial)")
     run.add_argument("--scheduler", default=None,
                      help="address of an existing dask scheduler (also $RAILOPT_SCHEDULER)")
-    run.add_argument("--resume", action="store_true", help="finish an interrupted campaign from its store")
-    run.add_argument("--fresh", action="store_true", help="discard existing campaign stores of this study first")
+    stores = run.add_mutually_exclusive_group()
+    stores.add_argument("--resume", action="store_true", help="finish an interrupted campaign from its store")
+    stores.add_argument("--fresh", action="store_true", help="discard existing campaign stores of this study first")
     run.add_argument("--results", default="results", help="results root folder (default: ./results)")
     run.add_argument("--no-progress", action="store_true", help="no progress bars")
     run.set_defaults(func=cmd_run)

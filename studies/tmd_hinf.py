@@ -9,6 +9,7 @@ and Den Hartog, and states how far the thesis approximation is from the true pea
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import Literal
 
@@ -17,7 +18,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from pydantic import Field, field_validator
 
-from railopt.design import DesignVariable, MinimaxProblem, distinct_optima
+from railopt.design import DesignVariable, MinimaxProblem
 from railopt.models.tmd import (
     amplification,
     den_hartog,
@@ -35,7 +36,7 @@ from railopt.studies.base import (
     StudyOutcome,
     dask_context,
 )
-from railopt.studies.campaign import CampaignSettings, check_stores, run_campaign
+from railopt.studies.campaign import CampaignSettings, check_optima, check_stores, run_campaign
 from railopt.studies.report import markdown_table, write_table
 
 
@@ -104,6 +105,16 @@ def true_peak(mass_ratio: float, tuning: float, damping_ratio: float, model: TMD
     return tmd_system(mass_ratio, m1, k1).response_maxima(p, band, exact=True).value
 
 
+def spectral_abscissa(mass_ratio: float, model: TMDModel, x: np.ndarray) -> tuple[float, dict[str, bool]]:
+    """Stability check of a design: the largest real part of the roots of G (4.53), 1/s."""
+    m1 = model.primary_mass_kg
+    k1 = m1 * (2 * np.pi * model.primary_frequency_hz) ** 2
+    p, _ = tmd_parameters(x[0], x[1], mass_ratio, m1, k1)
+    roots = tmd_system(mass_ratio, m1, k1).at(p).eigenvalues()
+    value = float(np.max(roots.real))
+    return value, {"stable": value < 0}
+
+
 def _label(mu: float, objective: str) -> str:
     return f"mu{mu:g}-{objective}"
 
@@ -116,6 +127,7 @@ def run(config: TMDStudyConfig, context: StudyContext) -> StudyOutcome:
     base_config = config.model_dump(mode="json")
 
     tables: dict[tuple[float, str], pd.DataFrame] = {}
+    stability: dict[tuple[float, str], pd.DataFrame] = {}
     with dask_context(context) as client:
         for mu, obj in campaigns:
             problem = problems[(mu, obj)]
@@ -123,6 +135,8 @@ def run(config: TMDStudyConfig, context: StudyContext) -> StudyOutcome:
             points = [[dh.tuning, dh.damping_ratio]] if design.start_from_den_hartog else None
             cfg = {**base_config, "campaign": {"mass_ratio": mu, "objective": obj}}
             tables[(mu, obj)] = run_campaign(problem, _label(mu, obj), design, context, cfg, client, points)
+            stability[(mu, obj)] = check_optima(problem, tables[(mu, obj)], _label(mu, obj), context,
+                                                "spectral_abscissa", partial(spectral_abscissa, mu, model), client)
 
     rows, starts, optima = [], [], []
     for (mu, obj), table in tables.items():
@@ -152,11 +166,12 @@ def run(config: TMDStudyConfig, context: StudyContext) -> StudyOutcome:
             "DH_damping_ratio": dh.damping_ratio,
             "DH_true_peak": dh.peak,
             "DH_fixed_point_height": den_hartog_fixed_point_height(mu),
-            "distinct_optima": int((table["cluster"] >= 0).any() and table["cluster"].max() + 1),
+            "distinct_optima": len(stability[(mu, obj)]),
+            "all_optima_stable": bool(stability[(mu, obj)]["stable"].all()),
         }
         rows.append(row)
         starts.append(table.drop(columns=["functions"]).assign(mass_ratio=mu, objective=obj))
-        optima.append(distinct_optima(table, problem).assign(mass_ratio=mu, objective=obj))
+        optima.append(stability[(mu, obj)].assign(mass_ratio=mu, objective=obj))
 
     summary = pd.DataFrame(rows)
     files = write_table(summary, context.outdir, "comparison")

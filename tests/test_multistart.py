@@ -16,6 +16,7 @@ from railopt.design import (
     CampaignStore,
     DesignVariable,
     MinimaxProblem,
+    check_designs,
     dask_client,
     distinct_optima,
     multistart,
@@ -164,3 +165,20 @@ def test_killed_worker_campaign_still_completes(client, tmp_path):
     assert list(table["start_id"]) == list(range(12))
     assert table["success"].sum() >= 11
     assert np.nanmin(table["value"]) == pytest.approx(2.0, abs=1e-6)
+
+
+def test_checks_of_optima_run_as_tasks_and_land_in_the_store(client, tmp_path):
+    """A stability-style check: the spectral abscissa of x'' + 2ζω x' + ω² x = 0 is −ζω."""
+    store = CampaignStore.create(tmp_path / "c.sqlite", "c", {}, ["zeta", "omega"])
+    designs = pd.DataFrame({"start_id": [3, 1, 2], "zeta": [0.1, 0.3, 0.05], "omega": [2.0, 1.0, 10.0]})
+
+    def abscissa(x):
+        s = np.roots([1.0, 2 * x[0] * x[1], x[1] ** 2])
+        return float(np.max(s.real)), {"stable": bool(np.max(s.real) < 0)}
+
+    out = check_designs(abscissa, designs, ["zeta", "omega"], "spectral_abscissa", client=client, store=store)
+    np.testing.assert_allclose(out["value"], [-0.3, -0.5, -0.2], rtol=1e-12)
+    stored = store.checks()
+    store.close()
+    assert list(stored["start_id"]) == [1, 2, 3] and stored["payload"].map(lambda p: p["stable"]).all()
+    np.testing.assert_allclose(stored["value"], out["value"], rtol=0)
