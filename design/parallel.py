@@ -2,6 +2,9 @@
 
 The design layer takes an optional ``client``; with none, the same code runs serially.
 Results stream back in completion order (``as_completed``); a lost worker's tasks are retried.
+Every task runs with single-threaded BLAS: parallelism is across tasks, small matrices gain
+nothing from threads, and a threaded BLAS rounds differently — with it, a serial run and a
+dask run of the same campaign would not give the same table.
 """
 
 from __future__ import annotations
@@ -9,9 +12,21 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from typing import Any
 
+from threadpoolctl import threadpool_limits
+
 SCHEDULER_ENV = "RAILOPT_SCHEDULER"
+
+
+@dataclass(frozen=True)
+class _SingleThreaded:
+    fn: Callable[[Any], Any]
+
+    def __call__(self, item: Any) -> Any:
+        with threadpool_limits(limits=1, user_api="blas"):
+            return self.fn(item)
 
 
 def map_unordered(
@@ -19,13 +34,14 @@ def map_unordered(
 ) -> Iterator[Any]:
     """Yield ``fn(item)`` for each item, in completion order; serial when ``client`` is None."""
     items = list(items)
+    task = _SingleThreaded(fn)
     if client is None:
         for item in items:
-            yield fn(item)
+            yield task(item)
         return
     from dask.distributed import as_completed
 
-    futures = client.map(fn, items, pure=False, retries=retries)
+    futures = client.map(task, items, pure=False, retries=retries)
     try:
         for future in as_completed(futures):
             yield future.result()

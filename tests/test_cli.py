@@ -121,3 +121,23 @@ def test_killed_campaign_resumes_with_every_start_exactly_once(tmp_path):
     b = pd.read_csv(fresh / "tmd_hinf" / "starts.csv")
     cols = ["start_id", "x0_tuning", "x0_damping_ratio", "tuning", "damping_ratio", "value", "status", "evaluations"]
     pd.testing.assert_frame_equal(a[cols], b[cols])
+
+
+def test_scheduler_address_runs_the_campaign_on_an_existing_cluster(tmp_path, monkeypatch):
+    from dask.distributed import LocalCluster
+
+    study = small_study(tmp_path, n_starts=4)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        on_cluster = tmp_path / "cluster"
+        assert main(["run", str(study), "--results", str(on_cluster), "--scheduler", cluster.scheduler_address,
+                     "--no-progress"]) == 0
+        monkeypatch.setenv("RAILOPT_SCHEDULER", cluster.scheduler_address)
+        via_env = tmp_path / "env"
+        assert main(["run", str(study), "--results", str(via_env), "--no-progress"]) == 0
+    serial = tmp_path / "serial"
+    monkeypatch.delenv("RAILOPT_SCHEDULER")
+    assert main(["run", str(study), "--results", str(serial), "--workers", "0", "--no-progress"]) == 0
+    cols = ["start_id", "tuning", "damping_ratio", "value", "status", "evaluations"]
+    ref = pd.read_csv(serial / "tmd_hinf" / "starts.csv")[cols]
+    for root in (on_cluster, via_env):
+        pd.testing.assert_frame_equal(pd.read_csv(root / "tmd_hinf" / "starts.csv")[cols], ref)

@@ -137,6 +137,17 @@ def test_local_cluster_gives_the_serial_table(client):
     pd.testing.assert_frame_equal(parallel[DETERMINISTIC], serial[DETERMINISTIC])
 
 
+def test_local_cluster_gives_the_serial_table_for_a_lapack_model(client):
+    """Eigen-decompositions and complex solves round identically in workers and in-process."""
+    from railopt.studies.tmd_hinf import TMDDesign, TMDModel, tmd_problem
+
+    problem = tmd_problem(0.05, TMDModel(), TMDDesign(), exact=True)
+    serial = multistart(problem, 8, seed=2002)
+    parallel = multistart(problem, 8, seed=2002, client=client)
+    cols = [c.replace("x1", "tuning").replace("x2", "damping_ratio") for c in DETERMINISTIC]
+    pd.testing.assert_frame_equal(parallel[cols], serial[cols])
+
+
 def slow_cb3() -> MinimaxProblem:
     base = minimax_test_problems()["CB3"].problem
 
