@@ -36,14 +36,7 @@ import numpy as np
 import pandas as pd
 from scipy import special
 
-from railopt.models.track.beam import Beam
-
-
-def _finite(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return value
+from railopt.models.track.beam import Beam, _check_finite
 
 
 @dataclass(frozen=True)
@@ -72,7 +65,7 @@ class MovingLoad:
 
     def __post_init__(self) -> None:
         for name in ("P", "v", "x0", "Omega", "acceleration"):
-            object.__setattr__(self, name, _finite(name, getattr(self, name)))
+            object.__setattr__(self, name, _check_finite(name, getattr(self, name)))
 
     def position(self, t: np.ndarray | float) -> np.ndarray:
         """Load position s(t), m."""
@@ -97,8 +90,8 @@ class ImpulseLoad:
     x0: float = 0.0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "impulse", _finite("impulse", self.impulse))
-        object.__setattr__(self, "x0", _finite("x0", self.x0))
+        object.__setattr__(self, "impulse", _check_finite("impulse", self.impulse))
+        object.__setattr__(self, "x0", _check_finite("x0", self.x0))
 
 
 @dataclass(frozen=True)
@@ -111,7 +104,7 @@ class DistributedImpulse:
 
     def __post_init__(self) -> None:
         for name in ("impulse_per_length", "x1", "x2"):
-            object.__setattr__(self, name, _finite(name, getattr(self, name)))
+            object.__setattr__(self, name, _check_finite(name, getattr(self, name)))
         if not self.x2 > self.x1:
             raise ValueError(f"x2 must be greater than x1, got x1={self.x1!r}, x2={self.x2!r}")
 
@@ -287,7 +280,7 @@ def transient(
     point = isinstance(load, MovingLoad)
     if kappa_max_factor is None:
         kappa_max_factor = 16.0 if point else 60.0
-    kappa_max_factor = _finite("kappa_max_factor", kappa_max_factor)
+    kappa_max_factor = _check_finite("kappa_max_factor", kappa_max_factor)
     if kappa_max_factor < 4.0:
         raise ValueError(f"kappa_max_factor must be at least 4, got {kappa_max_factor!r}")
     kappa_max = kappa_max_factor * beam.beta
