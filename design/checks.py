@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import map_unordered
+from railopt.design.parallel import call, map_unordered
 from railopt.design.store import CampaignStore
 
 Check = Callable[[np.ndarray], tuple[float, Mapping[str, Any]]]
@@ -29,9 +29,6 @@ class _CheckTask:
         value, payload = self.check(self.x)
         return self.start_id, float(value), dict(payload)
 
-
-def _run(task: _CheckTask) -> tuple[int, float, Mapping[str, Any]]:
-    return task()
 
 
 def check_designs(
@@ -54,7 +51,7 @@ def check_designs(
         raise ValueError(f"designs: missing variable columns {missing}")
     tasks = [_CheckTask(check, int(r["start_id"]), r[variables].to_numpy(dtype=float)) for _, r in designs.iterrows()]
     rows = []
-    for start_id, value, payload in map_unordered(_run, tasks, client=client):
+    for start_id, value, payload in map_unordered(call, tasks, client=client):
         if store is not None:
             store.add_check(start_id, name, value, payload)
         rows.append({"start_id": start_id, "name": name, "value": value, **payload})

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import map_unordered
+from railopt.design.parallel import call, map_unordered
 from railopt.design.problem import MinimaxProblem
 from railopt.design.result import SolveResult
 from railopt.design.solve import method_options, solve
@@ -29,9 +29,6 @@ class _StartTask:
     def __call__(self) -> tuple[Start, SolveResult]:
         return self.start, solve(self.problem, self.start.x0, method=self.method, **self.options)
 
-
-def _run(task: _StartTask) -> tuple[Start, SolveResult]:
-    return task()
 
 
 def multistart(
@@ -92,7 +89,7 @@ def multistart(
             progress(done, total)
         user_options = dict(options or {})
         tasks = [_StartTask(problem, s, method, user_options) for s in todo]
-        for start, result in map_unordered(_run, tasks, client=client):
+        for start, result in map_unordered(call, tasks, client=client):
             store.add_start(start.start_id, start.origin, seed, result)
             done += 1
             if progress is not None:

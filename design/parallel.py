@@ -29,6 +29,11 @@ class _SingleThreaded:
             return self.fn(item)
 
 
+def call(task: Callable[[], Any]) -> Any:
+    """Run a self-contained task object: ``map_unordered(call, tasks, client)``."""
+    return task()
+
+
 def map_unordered(
     fn: Callable[[Any], Any], items: Iterable[Any], client: Any = None, retries: int = 3
 ) -> Iterator[Any]:

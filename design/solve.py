@@ -61,18 +61,13 @@ def solve(problem: MinimaxProblem, x0: Sequence[float], method: str = "slsqp", *
         return _result(problem, x0, x0, None, np.inf, stop.status, stop.message, 0, start, method)
     outcome = METHODS[method].run(view, problem.space.to_u(x0), opts)
     # re-evaluate ourselves: the solver's point, or the best point it evaluated if that is better
-    candidates = [problem.space.to_x(np.clip(outcome.u, 0.0, 1.0))]
-    if np.isfinite(view.best_merit):
-        candidates.append(view.best_x)
-    best_x, best_ev = candidates[0], None
-    for x in candidates:
-        ev = _safe_evaluate(problem, x)
-        if ev is not None and problem.constraint_violation(x, ev) <= 1e-9 and (
-            best_ev is None or ev.value < best_ev.value
-        ):
-            best_x, best_ev = x, ev
-    if best_ev is None:  # nothing feasible: report the solver's point as it is
-        best_ev = _safe_evaluate(problem, best_x)
+    x_solver = problem.space.to_x(np.clip(outcome.u, 0.0, 1.0))
+    evaluated = [(x_solver, _safe_evaluate(problem, x_solver))]
+    if np.isfinite(view.best_merit) and not np.array_equal(view.best_x, x_solver):
+        evaluated.append((view.best_x, _safe_evaluate(problem, view.best_x)))
+    feasible = [(x, ev) for x, ev in evaluated if ev is not None and problem.constraint_violation(x, ev) <= 1e-9]
+    # nothing feasible: report the solver's point as it is
+    best_x, best_ev = min(feasible, key=lambda xe: xe[1].value) if feasible else evaluated[0]
     return _result(problem, x0, best_x, best_ev, outcome.tau, outcome.status, outcome.message,
                    view.evaluations, start, method)
 

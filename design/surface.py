@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import map_unordered
+from railopt.design.parallel import call, map_unordered
 from railopt.design.problem import MinimaxProblem
 
 
@@ -48,7 +48,7 @@ class _Row:
     xi: np.ndarray
     xj_value: float
 
-    def __call__(self) -> np.ndarray:
+    def __call__(self) -> tuple[float, np.ndarray]:
         out = np.empty(len(self.xi))
         for k, v in enumerate(self.xi):
             x = self.base.copy()
@@ -57,11 +57,7 @@ class _Row:
                 out[k] = self.problem.value(x)
             except ValueError:  # e.g. a singular model at zero stiffness: no finite response
                 out[k] = np.inf
-        return out
-
-
-def _row(task: _Row) -> tuple[float, np.ndarray]:
-    return task.xj_value, task()
+        return self.xj_value, out
 
 
 def objective_surface(
@@ -84,7 +80,7 @@ def objective_surface(
     if base.shape != (space.dim,) or not np.all(np.isfinite(base)):
         raise ValueError(f"base: expected {space.dim} finite values")
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
-    rows = dict(map_unordered(_row, [_Row(problem, base, i, j, xi, float(v)) for v in xj], client=client))
+    rows = dict(map_unordered(call, [_Row(problem, base, i, j, xi, float(v)) for v in xj], client=client))
     values = np.array([rows[float(v)] for v in xj])
     inside_i = (xi >= space.lower[i]) & (xi <= space.upper[i])
     inside_j = (xj >= space.lower[j]) & (xj <= space.upper[j])

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import map_unordered
+from railopt.design.parallel import call, map_unordered
 from railopt.design.problem import MinimaxProblem
 from railopt.design.solve import method_options, solve
 from railopt.design.starts import start_points
@@ -53,9 +53,6 @@ class _SweepTask:
         return self.epsilon, solve(self.problem.with_epsilon(self.epsilon), self.x0, self.method, **self.options)
 
 
-def _run(task: _SweepTask) -> tuple[float, Any]:
-    return task()
-
 
 def epsilon_sweep(
     problem: MinimaxProblem,
@@ -81,7 +78,7 @@ def epsilon_sweep(
     starts = start_points(problem.space, n_starts, seed=seed, points=points)
     tasks = [_SweepTask(problem, e, s.x0, method, dict(options or {})) for e in eps for s in starts]
     best: dict[float, Any] = {}
-    for e, r in map_unordered(_run, tasks, client=client):
+    for e, r in map_unordered(call, tasks, client=client):
         if r.feasible and np.isfinite(r.value) and (e not in best or r.value < best[e].value):
             best[e] = r
     rows = []

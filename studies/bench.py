@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from railopt.design import MinimaxProblem, dask_client, multistart
-from railopt.models.tmd import nishihara_asami, tmd_parameters, tmd_system
+from railopt.models.tmd import nishihara_asami
 from railopt.studies.report import markdown_table
 from railopt.studies.tmd_hinf import TMDDesign, TMDModel, tmd_problem
 
@@ -46,13 +46,10 @@ def run_bench(out: Path, workers: int = 2, quick: bool = False) -> pd.DataFrame:
     repeat = 20 if quick else 200
     mu = 0.05
     model = TMDModel()
-    m1 = model.primary_mass_kg
-    k1 = m1 * (2 * np.pi * model.primary_frequency_hz) ** 2
-    w1 = np.sqrt(k1 / m1)
-    band = (0.5 * w1, 1.5 * w1)
-    ps = tmd_system(mu, m1, k1)
+    band = model.band_rad_s
+    ps = model.system(mu)
     na = nishihara_asami(mu)
-    p, _ = tmd_parameters(na.tuning, na.damping_ratio, mu, m1, k1)
+    p, _ = model.parameters(mu, np.array([na.tuning, na.damping_ratio]))
     sys = ps.at(p)
     n = sys.n
     rows = []

@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 from pydantic import Field, field_validator
 
 from railopt.design import DesignVariable, MinimaxProblem
+from railopt.models.parametric import ParametricSystem
 from railopt.models.tmd import (
     amplification,
     den_hartog,
@@ -61,6 +62,23 @@ class TMDModel(StrictModel):
             raise ValueError(f"lower edge must be ≥ 0, got {v[0]}")
         return v
 
+    @property
+    def primary_stiffness_n_m(self) -> float:
+        return self.primary_mass_kg * (2 * np.pi * self.primary_frequency_hz) ** 2
+
+    @property
+    def band_rad_s(self) -> tuple[float, float]:
+        w1 = 2 * np.pi * self.primary_frequency_hz
+        return self.band_ratio[0] * w1, self.band_ratio[1] * w1
+
+    def system(self, mass_ratio: float) -> ParametricSystem:
+        """The TMD model for one mass ratio, parameters (k2, c2)."""
+        return tmd_system(mass_ratio, self.primary_mass_kg, self.primary_stiffness_n_m)
+
+    def parameters(self, mass_ratio: float, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(k2, c2) for a design x = (γ, ζ) and the Jacobian d(k2, c2)/dx."""
+        return tmd_parameters(x[0], x[1], mass_ratio, self.primary_mass_kg, self.primary_stiffness_n_m)
+
 
 class TMDDesign(CampaignSettings):
     tuning_bounds: Interval = (0.5, 1.5)
@@ -77,14 +95,11 @@ class TMDStudyConfig(StrictModel):
 
 def tmd_problem(mass_ratio: float, model: TMDModel, design: TMDDesign, exact: bool) -> MinimaxProblem:
     """Minimax problem over (γ, ζ) for one mass ratio; analytic gradients via the chain rule."""
-    m1 = model.primary_mass_kg
-    k1 = m1 * (2 * np.pi * model.primary_frequency_hz) ** 2
-    w1 = np.sqrt(k1 / m1)
-    band = (model.band_ratio[0] * w1, model.band_ratio[1] * w1)
-    system = tmd_system(mass_ratio, m1, k1)
+    band = model.band_rad_s
+    system = model.system(mass_ratio)
 
     def functions(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        p, dp_dx = tmd_parameters(x[0], x[1], mass_ratio, m1, k1)
+        p, dp_dx = model.parameters(mass_ratio, x)
         rm, J = system.response_maxima_jacobian(p, band, exact=exact)
         return rm.values, J @ dp_dx
 
@@ -97,20 +112,14 @@ def tmd_problem(mass_ratio: float, model: TMDModel, design: TMDDesign, exact: bo
 
 def true_peak(mass_ratio: float, tuning: float, damping_ratio: float, model: TMDModel) -> float:
     """Certified band maximum of |X1 k1/F| for a design (the exact option of the model layer)."""
-    m1 = model.primary_mass_kg
-    k1 = m1 * (2 * np.pi * model.primary_frequency_hz) ** 2
-    w1 = np.sqrt(k1 / m1)
-    p, _ = tmd_parameters(tuning, damping_ratio, mass_ratio, m1, k1)
-    band = (model.band_ratio[0] * w1, model.band_ratio[1] * w1)
-    return tmd_system(mass_ratio, m1, k1).response_maxima(p, band, exact=True).value
+    p, _ = model.parameters(mass_ratio, np.array([tuning, damping_ratio]))
+    return model.system(mass_ratio).response_maxima(p, model.band_rad_s, exact=True).value
 
 
 def spectral_abscissa(mass_ratio: float, model: TMDModel, x: np.ndarray) -> tuple[float, dict[str, bool]]:
     """Stability check of a design: the largest real part of the roots of G (4.53), 1/s."""
-    m1 = model.primary_mass_kg
-    k1 = m1 * (2 * np.pi * model.primary_frequency_hz) ** 2
-    p, _ = tmd_parameters(x[0], x[1], mass_ratio, m1, k1)
-    roots = tmd_system(mass_ratio, m1, k1).at(p).eigenvalues()
+    p, _ = model.parameters(mass_ratio, x)
+    roots = model.system(mass_ratio).at(p).eigenvalues()
     value = float(np.max(roots.real))
     return value, {"stable": value < 0}
 
