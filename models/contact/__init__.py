@@ -1,0 +1,103 @@
+"""Wheel/rail contact: geometry, Hertz ellipse, creep coefficients, gravity stiffness, conicity.
+
+Thesis §4.2.1–4.2.2, equations (4.1)–(4.32) and (4.43)–(4.49); SI units throughout (m, N, rad, Pa).
+Details, sources, sign conventions and the garbled-OCR notes: ``docs/contact.md``.
+
+Public API
+----------
+Geometry (4.1)–(4.8) — :mod:`.geometry`
+
+* ``WheelRailGeometry(r0, e0, conicity, theta0, epsilon, eta=0.0)`` — frozen; ``.psi`` (4.8), ``.l18`` = 2 e0,
+  ``.l20`` = r0, ``.contact_angles(v, alpha_de=0.0)``, ``.contact_distances(v)``, ``.rolling_radii(v)``,
+  ``.roll(v)``; constructors ``WheelRailGeometry.coned(r0, e0, conicity)`` and
+  ``WheelRailGeometry.from_circular_profiles(r0, e0, delta0, R_wheel, R_rail)``.
+  ``v`` is positive towards the right rail (the thesis's convention).
+
+Hertz (4.19)–(4.20) — :mod:`.hertz`
+
+* ``hertz_ellipse(N, E, nu, A, B) -> HertzEllipse(a, b, m, n, p0)`` (``.c`` = √(ab), ``.aspect`` = a/b);
+  a along the rolling direction, A, B the relative curvatures along x (rolling) and y (lateral).
+* ``hertz_coefficients(curvature_ratio) -> (m, n, g)``;
+  ``wheel_rail_curvatures(r_wheel, R_rail, R_wheel_transverse=inf) -> (A, B)``.
+
+Creep (4.9)–(4.32) — :mod:`.creep`
+
+* ``creep_coefficients(a, b, G, nu, theory="vermeulen-johnson" | "kalker" | "carter", factor=1.0, *, r0=None,
+  N=None) -> CreepCoefficients``
+* ``CreepCoefficients(f11, f22, f23=0.0, f33=0.0, f32=None)`` — per wheel; f11, f22 in N, f23, f32 in N·m,
+  f33 in N·m²; f32 defaults to −f23; ``.scaled(factor)``, ``.forces(xi_x, xi_y, xi_sp)``.
+* ``kalker_coefficients(a_over_b, nu) -> array([C11, C22, C23, C33])``,
+  ``vermeulen_johnson_phi_psi(a_over_b, nu) -> (Phi, Psi1)``, ``carter_coefficient(r0, N)`` (N).
+
+Gravity and track roll (4.43)–(4.49) — :mod:`.gravity` (coefficients on the equations' left-hand sides)
+
+* ``lateral_gravity_stiffness(W, geometry)`` = Wε/e0 (N/m); ``lateral_track_roll_coupling(W)`` = −W;
+  ``roll_gravity_stiffness(W, geometry)`` = −W(η + r0ε/e0); ``roll_track_roll_coupling(W, geometry)`` = r0 W;
+  ``roll_load_transfer_arm(geometry)`` = e0 − r0θ0; ``yaw_gravity_stiffness(W, geometry)`` = −e0θ0W;
+  ``track_roll_terms(W, e0, K_e_roll, C_e_roll, m_e) -> TrackRollTerms``.
+
+Equivalent conicity (EN 15302 integral method) — :mod:`.conicity`
+
+* ``equivalent_conicity(y, delta_r, amplitude, r0=0.46, e0=0.75) -> float`` (tan γe); Δr = r_l − r_r,
+  y positive to the left; ``kinematic_wavelength(...)`` (m), ``turning_points(y, delta_r, amplitude)``,
+  ``linear_delta_r_table(conicity, y_max=0.012, n=241) -> (y, delta_r)``.
+"""
+
+from railopt.models.contact.conicity import (
+    equivalent_conicity,
+    kinematic_wavelength,
+    linear_delta_r_table,
+    turning_points,
+)
+from railopt.models.contact.creep import (
+    CARTER_CONSTANT_SI,
+    CARTER_CONSTANT_US,
+    THEORIES,
+    CreepCoefficients,
+    carter_coefficient,
+    creep_coefficients,
+    johnson_spin,
+    kalker_coefficients,
+    vermeulen_johnson_phi_psi,
+)
+from railopt.models.contact.geometry import WheelRailGeometry
+from railopt.models.contact.gravity import (
+    TrackRollTerms,
+    lateral_gravity_stiffness,
+    lateral_track_roll_coupling,
+    roll_gravity_stiffness,
+    roll_load_transfer_arm,
+    roll_track_roll_coupling,
+    track_roll_terms,
+    yaw_gravity_stiffness,
+)
+from railopt.models.contact.hertz import HertzEllipse, hertz_coefficients, hertz_ellipse, wheel_rail_curvatures
+
+__all__ = [
+    "CARTER_CONSTANT_SI",
+    "CARTER_CONSTANT_US",
+    "THEORIES",
+    "CreepCoefficients",
+    "HertzEllipse",
+    "TrackRollTerms",
+    "WheelRailGeometry",
+    "carter_coefficient",
+    "creep_coefficients",
+    "equivalent_conicity",
+    "hertz_coefficients",
+    "hertz_ellipse",
+    "johnson_spin",
+    "kalker_coefficients",
+    "kinematic_wavelength",
+    "lateral_gravity_stiffness",
+    "lateral_track_roll_coupling",
+    "linear_delta_r_table",
+    "roll_gravity_stiffness",
+    "roll_load_transfer_arm",
+    "roll_track_roll_coupling",
+    "track_roll_terms",
+    "turning_points",
+    "vermeulen_johnson_phi_psi",
+    "wheel_rail_curvatures",
+    "yaw_gravity_stiffness",
+]

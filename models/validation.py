@@ -1,0 +1,73 @@
+"""Input checks of the model layer: one helper per kind of input, one message style.
+
+Every error is a ``ValueError`` whose message starts with the field name: ``"band: inverted …"``.
+Numpy scalars are accepted wherever Python numbers are; complex values where real ones belong,
+booleans where numbers belong, NaN and infinities are refused.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+
+import numpy as np
+
+
+def number(name: str, value: object, *, positive: bool = False, non_negative: bool = False) -> float:
+    """A finite real number (Python or numpy scalar, not bool), optionally > 0 or ≥ 0."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, Real | np.floating | np.integer):
+        raise ValueError(f"{name}: must be a real number, got {value!r}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{name}: must be finite, got {v}")
+    if positive and not v > 0:
+        raise ValueError(f"{name}: must be positive, got {v}")
+    if non_negative and not v >= 0:
+        raise ValueError(f"{name}: must be ≥ 0, got {v}")
+    return v
+
+
+def real_array(name: str, value: object, shape: tuple[int, ...] | None = None, ndim: int | None = None) -> np.ndarray:
+    """A finite real float array; complex input is an error (never a silently dropped imaginary part)."""
+    arr = np.asarray(value)
+    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool):
+        raise ValueError(f"{name}: must be a numeric array, got dtype {arr.dtype}")
+    if np.iscomplexobj(arr):
+        raise ValueError(f"{name}: must be real, got a complex array (dtype {arr.dtype})")
+    arr = arr.astype(float)
+    if ndim is not None and arr.ndim != ndim:
+        raise ValueError(f"{name}: must be a {ndim}-D array, got shape {arr.shape}")
+    if shape is not None and arr.shape != shape:
+        raise ValueError(f"{name}: must have shape {shape}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name}: contains NaN or infinite entries")
+    return arr
+
+
+def square_matrix(name: str, value: object, n: int | None = None) -> np.ndarray:
+    """A finite real square matrix, at least 1×1, of size n when given."""
+    a = real_array(name, value, ndim=2)
+    if a.shape[0] != a.shape[1] or a.shape[0] == 0:
+        raise ValueError(f"{name}: must be a non-empty square matrix, got shape {a.shape}")
+    if n is not None and a.shape[0] != n:
+        raise ValueError(f"{name}: shape {a.shape} does not match M's ({n}, {n})")
+    return a
+
+
+def band(value: object, name: str = "band") -> tuple[float, float]:
+    """A frequency band (rad/s): exactly two finite edges, 0 ≤ Ω_l < Ω_u."""
+    try:
+        edges = list(value)  # type: ignore[call-overload]
+    except TypeError as exc:
+        raise ValueError(f"{name}: must be a pair (lower, upper) in rad/s, got {value!r}") from exc
+    if len(edges) != 2:
+        raise ValueError(f"{name}: must be a pair (lower, upper) in rad/s, got {len(edges)} values")
+    try:
+        lo, hi = number(name, edges[0]), number(name, edges[1])
+    except ValueError as exc:
+        raise ValueError(f"{exc} (band edges must be finite numbers in rad/s)") from None
+    if lo < 0:
+        raise ValueError(f"{name}: lower edge must be ≥ 0, got {lo}")
+    if not hi > lo:
+        raise ValueError(f"{name}: is empty or inverted, lower {lo} ≥ upper {hi}")
+    return lo, hi

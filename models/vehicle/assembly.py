@@ -1,0 +1,163 @@
+"""Assemble M, K, C of all body coordinates and the constraint transformation (App. B method).
+
+The assembly runs once per vehicle and track variant: suspension elements are stored as the
+matrix multiplying their parameter (``K = K0 + Σ p_i K_i``), creep damping as ``C_creep`` (the
+damping is ``C_creep / S``), so new parameter values or a new speed never re-run it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from railopt.models.vehicle.bodies import Body
+from railopt.models.vehicle.constraints import Relation, fixed, hinge, rigid_tie, transformation
+from railopt.models.vehicle.elements import GROUND, Element
+from railopt.models.vehicle.geometry import DOFS, coordinate
+from railopt.models.vehicle.wheelrail import contact_matrices
+
+if TYPE_CHECKING:
+    from railopt.models.vehicle.vehicle import Vehicle
+
+TRACKS = ("rigid", "flexible")
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """Matrices over all coordinates z (6 per body, then the prescribed inputs).
+
+    Attributes
+    ----------
+    coordinates : tuple of str
+        All coordinates z; the last ``len(inputs)`` are the prescribed inputs.
+    inputs : tuple of str
+        Rail irregularity coordinates ``"<wheelset>_rail.v"`` (alignment), ``".w"`` (vertical
+        profile) and on rigid track ``".alpha"`` (cross level).
+    M, K0, C0, C_creep : (n, n) ndarray
+        Mass, constant stiffness and damping, and creep damping times speed.
+    parts : dict
+        Parameter id -> (``"K"`` or ``"C"``, weight matrix).
+    values : dict
+        Parameter id -> value used by :meth:`K` and :meth:`C`.
+    T, T_in : ndarray
+        ``z = T x + T_in u`` (B.1.48).
+    independent : tuple of str
+        Names of x.
+    """
+
+    coordinates: tuple[str, ...]
+    inputs: tuple[str, ...]
+    bodies: tuple[Body, ...]
+    M: np.ndarray
+    K0: np.ndarray
+    C0: np.ndarray
+    C_creep: np.ndarray
+    parts: dict[str, tuple[str, np.ndarray]]
+    values: dict[str, float]
+    T: np.ndarray
+    T_in: np.ndarray
+    independent: tuple[str, ...]
+
+    def K(self) -> np.ndarray:
+        """Full stiffness at the stored parameter values, N/m and N·m/rad."""
+        return self.K0 + sum((v * self.parts[k][1] for k, v in self.values.items() if self.parts[k][0] == "K"),
+                             np.zeros_like(self.K0))
+
+    def C(self, speed: float) -> np.ndarray:
+        """Full damping at forward speed ``speed`` (m/s)."""
+        C = self.C0 + self.C_creep / speed
+        return C + sum((v * self.parts[k][1] for k, v in self.values.items() if self.parts[k][0] == "C"),
+                       np.zeros_like(self.C0))
+
+
+def track_body_name(wheelset: str) -> str:
+    return f"{wheelset}_track"
+
+
+def rail_name(wheelset: str) -> str:
+    return f"{wheelset}_rail"
+
+
+def assemble(vehicle: Vehicle, track: str = "rigid") -> Assembly:
+    """Assemble the vehicle on ``"rigid"`` or ``"flexible"`` (lumped, (4.33)–(4.49)) track."""
+    if track not in TRACKS:
+        raise ValueError(f"track: must be one of {TRACKS}, got {track!r}")
+    wheelsets = [b for b in vehicle.bodies if b.kind == "wheelset"]
+    bodies = list(vehicle.bodies)
+    elements: list[Element] = []
+    relations: list[Relation] = []
+    wr = vehicle.wheel_rail() if wheelsets else None
+    if track == "flexible":
+        if vehicle.track is None:
+            raise ValueError(f"vehicle {vehicle.name!r}: flexible track needs a [track] table")
+        lt = vehicle.lumped_track()
+        for ws in wheelsets:
+            name = track_body_name(ws.name)
+            inertia = (lt.roll_inertia, 0.0, 0.0)
+            bodies.append(Body(name, lt.m_e_pair, inertia, (ws.cg[0], 0.0, 0.0), kind="track", source="lumped track"))
+            for side in (1.0, -1.0):
+                p = (0.0, side * wr.e0, 0.0)
+                elements.append(Element("track_K_e", "track_stiffness", "spring", name, p, GROUND, p, (0, 0, 1),
+                                        lt.K_e_prime))
+                elements.append(Element("track_C_e", "track_damping", "damper", name, p, GROUND, p, (0, 0, 1),
+                                        lt.C_e_prime))
+            relations += fixed(name, ("u", "v", "beta", "gamma"), origin=f"lumped track {name}")
+    inputs: list[str] = []
+    for ws in wheelsets:
+        rail = rail_name(ws.name)
+        inputs += [coordinate(rail, "v"), coordinate(rail, "w")]
+        if track == "rigid":
+            inputs.append(coordinate(rail, "alpha"))
+    coordinates = tuple(coordinate(b.name, d) for b in bodies for d in DOFS) + tuple(inputs)
+    index = {c: i for i, c in enumerate(coordinates)}
+    n = len(coordinates)
+    byname = {b.name: b for b in bodies}
+
+    M = np.zeros((n, n))
+    for b in bodies:
+        i = index[coordinate(b.name, "u")]
+        M[i:i + 6, i:i + 6] = b.mass_matrix
+
+    K0 = np.zeros((n, n))
+    C0 = np.zeros((n, n))
+    for e in elements:  # constant (track) elements
+        (K0 if e.matrix == "K" else C0)[...] += e.value * e.unit_matrix(index, n)
+    parts: dict[str, tuple[str, np.ndarray]] = {}
+    values: dict[str, float] = {}
+    for e in vehicle.elements:
+        kind, mat = parts.setdefault(e.id, (e.matrix, np.zeros((n, n))))
+        mat += e.unit_matrix(index, n)
+        values[e.id] = e.value
+
+    C_creep = np.zeros((n, n))
+    for ws in wheelsets:
+        rail = rail_name(ws.name)
+        if track == "flexible":
+            tb = track_body_name(ws.name)
+            roll = coordinate(tb, "alpha")
+            terms = ((coordinate(tb, "w"), 1.0), (coordinate(rail, "w"), 1.0))
+            relations.append(Relation(coordinate(ws.name, "w"), terms, f"contact {ws.name}"))
+        else:
+            tb = None
+            roll = coordinate(rail, "alpha")
+            relations.append(Relation(coordinate(ws.name, "w"), ((coordinate(rail, "w"), 1.0),), f"contact {ws.name}"))
+        relations.append(Relation(coordinate(ws.name, "alpha"),
+                                  ((roll, 1.0), (coordinate(ws.name, "v"), wr.psi), (coordinate(rail, "v"), -wr.psi)),
+                                  f"roll constraint (4.7) {ws.name}"))
+        Kc, Cc = contact_matrices(wr, index, ws.name, roll, coordinate(rail, "v"), tb, n)
+        K0 += Kc
+        C_creep += Cc
+
+    for c in vehicle.constraints:
+        body = byname[c.body]
+        if c.type == "fixed":
+            relations += fixed(c.body, c.dofs, origin=f"fixed {c.body}")
+        elif c.type == "rigid":
+            relations += rigid_tie(body, byname[c.to], c.dofs, origin=f"rigid {c.body}->{c.to}")
+        else:
+            relations += hinge(body, byname[c.to], c.axis, c.point, origin=f"hinge {c.body}->{c.to}")
+    T, T_in, independent = transformation(coordinates, relations, inputs)
+    return Assembly(coordinates, tuple(inputs), tuple(bodies), M, K0, C0, C_creep, parts, values, T, T_in,
+                    independent)

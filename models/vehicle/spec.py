@@ -1,0 +1,101 @@
+"""Frozen data of a vehicle definition other than bodies and elements: constraints, contact, track."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from railopt.models.vehicle.geometry import DOFS
+from railopt.models.vehicle.wheelrail import Creep
+
+CONSTRAINT_TYPES = ("rigid", "hinge", "fixed")
+CREEP_MODES = ("given", "hertz")
+
+
+@dataclass(frozen=True)
+class ConstraintSpec:
+    """A constraint as written in a vehicle file.
+
+    ``rigid``: ``body`` follows ``to`` in ``dofs``; ``hinge``: ``body`` tied to ``to`` except a
+    rotation about ``axis`` through ``point`` (relative to ``to``'s CG); ``fixed``: ``dofs`` of
+    ``body`` held at zero.
+    """
+
+    type: str
+    body: str
+    to: str = ""
+    dofs: tuple[str, ...] = ()
+    axis: str = "y"
+    point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if self.type not in CONSTRAINT_TYPES:
+            raise ValueError(f"constraint on {self.body!r}: type must be one of {CONSTRAINT_TYPES}, got {self.type!r}")
+        bad = [d for d in self.dofs if d not in DOFS]
+        if bad:
+            raise ValueError(f"constraint on {self.body!r}: unknown dofs {bad}; valid: {list(DOFS)}")
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """Wheel/rail data of the file's ``[contact]`` table (SI).
+
+    ``creep = "given"`` uses ``coefficients``; ``"hertz"`` computes them per wheel from the Hertz
+    ellipse under half the axle load (``railopt.models.contact``).  ``conicity`` may come from a
+    Δr table (``delta_r_y``, ``delta_r``, ``amplitude``) by the EN 15302 method.
+    """
+
+    r0: float
+    e0: float
+    conicity: float
+    theta0: float = 0.0
+    epsilon: float = 0.0
+    eta: float = 0.0
+    creep: str = "given"
+    coefficients: Creep | None = None
+    creep_factor: float = 1.0
+    spin: bool = True
+    gravity_stiffness: bool = True
+    axle_load: float | None = None
+    youngs_modulus: float = 2.07e11
+    poisson_ratio: float = 0.28
+    shear_modulus: float | None = None
+    theory: str = "kalker"
+    rail_head_radius: float = 0.254
+    wheel_transverse_radius: float = math.inf
+    source: str = "estimate"
+
+    def __post_init__(self) -> None:
+        if self.creep not in CREEP_MODES:
+            raise ValueError(f"contact.creep must be one of {CREEP_MODES}, got {self.creep!r}")
+        if self.creep == "given" and self.coefficients is None:
+            raise ValueError("contact: creep = 'given' needs f11_N and f22_N")
+        if not math.isfinite(self.creep_factor) or self.creep_factor <= 0.0:
+            raise ValueError(f"contact.creep_factor must be positive, got {self.creep_factor!r}")
+
+
+@dataclass(frozen=True)
+class TrackSpec:
+    """Per-rail track data for the lumped model (4.33)–(4.39), (4.49)."""
+
+    track_modulus: float  # N/m² per rail
+    rail_EI: float  # N·m²
+    mass_per_length: float  # kg/m per rail
+    damping_ratio: float = 0.1
+    source: str = "estimate"
+
+    def __post_init__(self) -> None:
+        for name in ("track_modulus", "rail_EI", "mass_per_length"):
+            v = getattr(self, name)
+            if not math.isfinite(v) or v <= 0.0:
+                raise ValueError(f"track.{name} must be positive and finite, got {v!r}")
+        if not math.isfinite(self.damping_ratio) or self.damping_ratio < 0.0:
+            raise ValueError(f"track.damping_ratio must be >= 0, got {self.damping_ratio!r}")
+
+
+@dataclass(frozen=True)
+class Lengths:
+    """Named lengths (thesis l1…l35 and others), m, with their sources."""
+
+    values: dict[str, float] = field(default_factory=dict)
+    sources: dict[str, str] = field(default_factory=dict)
