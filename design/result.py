@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
+
+from railopt.records import ArrayRecord
 
 STATUSES: dict[str, str] = {
     "converged": "a stopping tolerance (xtol/ftol) was reached",
@@ -19,8 +22,8 @@ SUCCESS_STATUSES = frozenset({"converged"})
 FEASIBILITY_TOL = 1e-6
 
 
-@dataclass(frozen=True)
-class SolveResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class SolveResult(ArrayRecord):
     """Outcome of one local solve, re-evaluated by railopt (not trusted from the solver).
 
     Attributes
@@ -68,6 +71,11 @@ class SolveResult:
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
             raise ValueError(f"status: unknown status {self.status!r}")
+        super().__post_init__()
+
+    def to_dict(self) -> dict[str, Any]:
+        """Every field, arrays as lists of floats (JSON-ready)."""
+        return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
 
     @property
     def feasible(self) -> bool:

@@ -15,10 +15,11 @@ import pandas as pd
 
 from railopt.design.parallel import call, map_unordered
 from railopt.design.problem import MinimaxProblem
+from railopt.records import ArrayRecord
 
 
-@dataclass(frozen=True)
-class Surface:
+@dataclass(frozen=True, eq=False, repr=False)
+class Surface(ArrayRecord):
     """U(x) on a grid: ``values[j, i]`` at ``x[names[0]] = xi[i]``, ``x[names[1]] = xj[j]``."""
 
     names: tuple[str, str]

@@ -8,50 +8,51 @@ f_l, f_u are the values at the band edges (4.72).
 Exact method (``exact=True``, beyond the thesis): the band is split into n cells whose
 boundaries are the midpoints between consecutive clipped ω_dj, and f_j is the maximum of |H|
 over cell j.  The union of the cells is the band, so ``max_k f_k`` *is* the band maximum, and
-each f_j is still continuous in the design (the maximum of a continuous function over an
-interval whose ends move continuously).  Each cell maximum is found on a grid whose spacing
-never exceeds ``GRID_FACTOR`` times the distance from Ω to the nearest pole s_j of H (and a
-quarter period of the largest delay in F), then refined by bounded Brent maximisation between
-the neighbours of the best sample.  A rational |H| cannot vary faster than the distance to its
-nearest pole allows, so the sampled maximum lies in the basin of the true one; that is what
-``certified`` records, together with the worst spacing ratio used.
+each f_j is still continuous in the design.  Each cell is sampled on a grid whose step never
+exceeds ``GRID_FACTOR`` times the distance from iΩ to the nearest pole of H, nor GRID_FACTOR times
+a quarter period 2π/(4τ_max) of the largest declared delay in F; the best sample is refined by
+golden-section search between its neighbours, and the reported value is a direct solve
+``Z(Ω)X = F`` at the refined frequency.  H is sampled in pole–residue form (O(n) per frequency)
+when the eigenvector matrix is well conditioned (:data:`~railopt.models.pole_residue.CONDITION_LIMIT`),
+by direct solves otherwise.
+
+``certified`` is a resolution certificate, not an interval proof: the spacing rule held at every
+step, every sample was finite, and every delay in F was declared (a plain callable forcing is
+never certified).  Between two poles a rational |H| cannot rise and fall within a quarter of the
+distance to the nearest pole, and a delayed term cannot within a sixteenth of its period, so the
+sampled maximum lies in the basin of the true one.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import minimize_scalar
 
-from railopt.models.linear_system import UNDAMPED_ROOT, LinearSystem
+from railopt.models.peak_search import cell_maxima
+from railopt.models.validation import band as validate_band
+from railopt.records import ArrayRecord
+
+if TYPE_CHECKING:  # pragma: no cover
+    from railopt.models.linear_system import LinearSystem
 
 GRID_FACTOR = 0.25  # max grid step / distance to nearest pole
 CERTIFIED_RATIO = GRID_FACTOR / (1 - GRID_FACTOR)
+POLE_STEP = 0.2  # step in u of the per-pole grids Ω = ω_k + σ_k sinh(u); keeps step/dist ≤ 0.222
 MIN_CELL_SAMPLES = 8
 MAX_GRID_POINTS = 200_000
-XATOL_REL = 1e-12
+UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
+CONSISTENCY_RTOL = 1e-6  # pole–residue vs direct value at a refined maximum; beyond it, redo by direct solves
+
+__all__ = ["ResponseMaxima", "all_response_maxima", "band_grid", "response_maxima", "validate_band"]
 
 
-def validate_band(band: tuple[float, float]) -> tuple[float, float]:
-    """Check a frequency band (rad/s): finite, 0 ≤ Ω_l < Ω_u. Errors name the field ``band``."""
-    try:
-        lo, hi = (float(band[0]), float(band[1]))
-    except (TypeError, ValueError, IndexError) as exc:
-        raise ValueError(f"band: must be a pair (lower, upper) in rad/s, got {band!r}") from exc
-    if not (np.isfinite(lo) and np.isfinite(hi)):
-        raise ValueError(f"band: edges must be finite, got ({lo}, {hi})")
-    if lo < 0:
-        raise ValueError(f"band: lower edge must be ≥ 0, got {lo}")
-    if not hi > lo:
-        raise ValueError(f"band: is empty or inverted, lower {lo} ≥ upper {hi}")
-    return lo, hi
-
-
-@dataclass(frozen=True)
-class ResponseMaxima:
-    """The vector f_k (4.73) with where each value was taken.
+@dataclass(frozen=True, eq=False, repr=False)
+class ResponseMaxima(ArrayRecord):
+    """The vector f_k (4.73) with where each value was taken; array-like (``np.asarray(rm)``
+    gives ``values``).
 
     Attributes
     ----------
@@ -66,10 +67,17 @@ class ResponseMaxima:
     exact : bool
         Whether the cell maxima of the exact method were used.
     certified : bool
-        Exact method only: the grid met the spacing rule everywhere and no value was singular.
+        Exact method only: the grid met the spacing rule everywhere, no sample was singular and
+        the forcing declared its delays.
     grid_ratio : float
         Exact method only: the largest grid step / distance to the nearest pole (certified when
         ≤ CERTIFIED_RATIO).
+    output : str
+        Name of the output.
+    evaluation : str
+        How H was sampled: ``"thesis"`` (n+2 direct solves), ``"pole-residue"`` or ``"direct"``.
+    grid_points : int
+        Exact method only: number of frequencies sampled.
     """
 
     values: np.ndarray
@@ -79,6 +87,9 @@ class ResponseMaxima:
     exact: bool
     certified: bool = False
     grid_ratio: float = float("nan")
+    output: str = "output"
+    evaluation: str = "thesis"
+    grid_points: int = 0
 
     @property
     def value(self) -> float:
@@ -95,7 +106,25 @@ class ResponseMaxima:
         n = len(self.damped_frequencies)
         return tuple(f"mode {j + 1}" for j in range(n)) + ("lower edge", "upper edge")
 
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        return np.array(self.values, dtype=dtype)
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+    def __getitem__(self, index):
+        return self.values[index]
+
+    def __iter__(self):
+        return iter(self.values)
+
+    def __repr__(self) -> str:
+        kind = ("exact, certified" if self.certified else "exact, not certified") if self.exact else "thesis"
+        return (f"ResponseMaxima(U={self.value:.6g} at {self.argmax_frequency:.6g} rad/s, n={len(self.values)}, "
+                f"output={self.output!r}, {kind}, band=({self.band[0]:g}, {self.band[1]:g}) rad/s)")
+
     def to_pandas(self) -> pd.DataFrame:
+        """One row per f_k: function, value, frequency_rad_s, frequency_hz."""
         return pd.DataFrame(
             {
                 "function": self.labels,
@@ -106,13 +135,25 @@ class ResponseMaxima:
         )
 
 
-def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool = False) -> ResponseMaxima:
-    """Response maxima f_k (4.71)-(4.73) of ``system`` over ``band`` (rad/s).
+def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool = False,
+                    output: str | None = None) -> ResponseMaxima:
+    """Response maxima f_k (4.71)-(4.73) of one output of ``system`` over ``band`` (rad/s).
 
     Zero damping or a singular Z(Ω) gives ``inf`` entries (never NaN), so U = +inf and an
     optimiser can carry on.
     """
+    name = system.output_names[system.output_index(output)]
+    return all_response_maxima(system, band, exact=exact, outputs=[name])[name]
+
+
+def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool = False,
+                        outputs: list[str] | None = None) -> dict[str, ResponseMaxima]:
+    """f_k of several outputs sharing one eigen-decomposition and one frequency grid."""
     lo, hi = validate_band(band)
+    names = list(system.output_names if outputs is None else outputs)
+    cols = [system.output_index(nm) for nm in names]
+    if exact:
+        system.modal()  # one eigen-decomposition with vectors serves the roots too
     wd = system.damped_frequencies()
     clipped = np.clip(wd, lo, hi)
     edges = np.array([lo, hi])
@@ -120,27 +161,60 @@ def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool
     resonant = system.undamped_modes() & (wd >= lo) & (wd <= hi)
     if not exact:
         freqs = np.concatenate([clipped, edges])
-        vals = _finite_or_inf(np.abs(system.frf(freqs)))
-        vals[: len(wd)][resonant] = np.inf
-        return ResponseMaxima(vals, freqs, wd, (lo, hi), exact=False)
+        H = _finite_or_inf(np.abs(system.frf_outputs(freqs)))
+        out = {}
+        for nm, c in zip(names, cols, strict=True):
+            vals = H[:, c].copy()
+            vals[: len(wd)][resonant] = np.inf
+            out[nm] = ResponseMaxima(vals, freqs, wd, (lo, hi), exact=False, output=nm)
+        return out
 
-    poles = system.eigenvalues()
+    poles = system.modal().s
     poles = poles[np.abs(poles.real) > UNDAMPED_ROOT * np.abs(poles)]  # their cells are inf anyway
-    grid = band_grid(poles, (lo, hi), max_delay=system.forcing.max_delay, extra=clipped)
-    mags = _finite_or_inf(np.abs(system.frf(grid)))
     bounds = np.concatenate([[lo], 0.5 * (clipped[1:] + clipped[:-1]), [hi]])
-    cell_vals = np.empty(len(wd))
-    cell_freqs = np.empty(len(wd))
-    for j in range(len(wd)):
-        cell_vals[j], cell_freqs[j] = _cell_maximum(system, grid, mags, bounds[j], bounds[j + 1])
-    cell_vals[resonant] = np.inf
-    cell_freqs[resonant] = clipped[resonant]
-    edge_vals = _finite_or_inf(np.abs(system.frf(edges)))
-    vals = np.concatenate([cell_vals, edge_vals])
-    freqs = np.concatenate([cell_freqs, edges])
-    ratio = _grid_ratio(grid, poles, system.forcing.max_delay)
-    certified = bool(np.all(np.isfinite(mags)) and ratio <= CERTIFIED_RATIO * (1 + 1e-9))
-    return ResponseMaxima(vals, freqs, wd, (lo, hi), exact=True, certified=certified, grid_ratio=ratio)
+    max_delay = system.forcing.max_delay
+    grid, ratio = band_grid(poles, (lo, hi), max_delay=max_delay or 0.0, extra=np.concatenate([clipped, bounds]))
+    pr = system.pole_residue()
+    result = _exact_cells(system, pr, grid, bounds, cols)
+    if result is None:  # pole–residue inconsistent with direct solves at a maximum: sample directly
+        pr = None
+        result = _exact_cells(system, None, grid, bounds, cols)
+    cell_f, cell_x, all_finite = result
+    edge_vals = _finite_or_inf(np.abs(system.frf_outputs(edges)))
+    certified = bool(all_finite and max_delay is not None and ratio <= CERTIFIED_RATIO * (1 + 1e-9))
+    out = {}
+    for i, (nm, c) in enumerate(zip(names, cols, strict=True)):
+        f, x = cell_f[i].copy(), cell_x[i].copy()
+        f[resonant] = np.inf
+        x[resonant] = clipped[resonant]
+        out[nm] = ResponseMaxima(
+            np.concatenate([f, edge_vals[:, c]]), np.concatenate([x, edges]), wd, (lo, hi), exact=True,
+            certified=certified, grid_ratio=ratio, output=nm,
+            evaluation="direct" if pr is None else "pole-residue", grid_points=len(grid),
+        )
+    return out
+
+
+def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
+                 cols: list[int]) -> tuple[np.ndarray, np.ndarray, bool] | None:
+    """Cell maxima (values by direct solves at the refined frequencies) for each output column."""
+    sample = system.frf_outputs if pr is None else pr.evaluate
+    mags = _finite_or_inf(np.abs(sample(grid)))
+    xs, fs = [], []
+    for c in cols:
+        x, f = cell_maxima(lambda w, c=c: _finite_or_inf(np.abs(sample(w)[:, c])), grid, mags[:, c], bounds)
+        xs.append(x)
+        fs.append(f)
+    X = np.array(xs)
+    direct = _finite_or_inf(np.abs(system.frf_outputs(X.ravel())))
+    F = np.array([direct[i * X.shape[1]:(i + 1) * X.shape[1], c] for i, c in enumerate(cols)])
+    if pr is not None:
+        sampled = np.array(fs)
+        ok = np.isfinite(sampled) & np.isfinite(F)
+        scale = np.max(np.where(ok, F, 0.0), initial=0.0)
+        if np.any(np.abs(sampled[ok] - F[ok]) > CONSISTENCY_RTOL * max(scale, 1e-300)):
+            return None
+    return F, X, bool(np.all(np.isfinite(mags[:, cols])))
 
 
 def _finite_or_inf(a: np.ndarray) -> np.ndarray:
@@ -150,79 +224,60 @@ def _finite_or_inf(a: np.ndarray) -> np.ndarray:
 
 
 def _step_limit(omega: np.ndarray, poles: np.ndarray, max_delay: float) -> np.ndarray:
-    """Largest admissible grid step at each Ω: GRID_FACTOR × distance to the nearest pole."""
-    if poles.size == 0:
-        return np.full(np.atleast_1d(omega).shape, np.inf)
-    dist = np.min(np.abs(1j * np.atleast_1d(omega)[:, None] - poles[None, :]), axis=1)
-    step = GRID_FACTOR * dist
+    """Largest admissible grid step at each Ω: GRID_FACTOR × distance to the nearest pole (and
+    GRID_FACTOR × a quarter period of the largest delay)."""
+    omega = np.atleast_1d(omega)
+    step = np.full(omega.shape, np.inf)
+    if poles.size:
+        d2 = (omega[:, None] - poles.imag[None, :]) ** 2 + (poles.real**2)[None, :]
+        step = GRID_FACTOR * np.sqrt(np.min(d2, axis=1))
     if max_delay > 0:
         step = np.minimum(step, GRID_FACTOR * 2 * np.pi / (4 * max_delay))
     return step
 
 
-def band_grid(
-    poles: np.ndarray,
-    band: tuple[float, float],
-    max_delay: float = 0.0,
-    extra: np.ndarray | None = None,
-) -> np.ndarray:
-    """Adaptive frequency grid (rad/s) over ``band`` with step ≤ GRID_FACTOR · dist(iΩ, poles).
-
-    The number of points grows with the logarithm of (band width / modal damping), so lightly
-    damped modes cost little.  ``extra`` points (e.g. the clipped ω_dj) are merged in.
-    """
-    lo, hi = band
-    floor = (hi - lo) / MAX_GRID_POINTS
-    cap = (hi - lo) / (4 * MIN_CELL_SAMPLES)
-    pts = [lo]
-    w = lo
-    while w < hi:
-        step = float(_step_limit(np.array([w]), poles, max_delay)[0])
-        w = w + min(max(step, floor), cap)
-        pts.append(min(w, hi))
-    grid = np.array(pts)
-    if extra is not None:
-        grid = np.union1d(grid, np.asarray(extra, dtype=float))
-    return grid
-
-
-def _grid_ratio(grid: np.ndarray, poles: np.ndarray, max_delay: float) -> float:
-    """Worst step / (distance to the nearest pole) over the grid, taking the nearer step end.
+def _step_ratios(grid: np.ndarray, poles: np.ndarray, max_delay: float) -> np.ndarray:
+    """Each step / (distance to the nearest pole at the nearer step end).
 
     The distance is 1-Lipschitz in Ω, so steps of GRID_FACTOR·dist(left end) keep this ratio
     below GRID_FACTOR / (1 − GRID_FACTOR) = CERTIFIED_RATIO.
     """
-    steps = np.diff(grid)
-    if steps.size == 0:
-        return 0.0
-    limit = np.minimum(_step_limit(grid[:-1], poles, max_delay), _step_limit(grid[1:], poles, max_delay))
-    with np.errstate(divide="ignore"):
-        return float(np.max(GRID_FACTOR * steps / limit))
+    limit = _step_limit(grid, poles, max_delay)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return GRID_FACTOR * np.diff(grid) / np.minimum(limit[:-1], limit[1:])
 
 
-def _cell_maximum(
-    system: LinearSystem, grid: np.ndarray, mags: np.ndarray, a: float, b: float
-) -> tuple[float, float]:
-    """Maximum of |H| over [a, b]: best grid sample, refined between its neighbours."""
-    inside = np.flatnonzero((grid >= a) & (grid <= b))
-    cand_w = [a, b]
-    cand_f = [float(np.abs(system.frf(a))), float(np.abs(system.frf(b)))]
-    if inside.size:
-        k = inside[int(np.argmax(mags[inside]))]
-        cand_w.append(float(grid[k]))
-        cand_f.append(float(mags[k]))
-        if np.isfinite(mags[k]):
-            left = max(a, float(grid[max(k - 1, 0)]))
-            right = min(b, float(grid[min(k + 1, len(grid) - 1)]))
-            if right > left:
-                res = minimize_scalar(
-                    lambda w: -float(np.abs(system.frf(w))),
-                    bounds=(left, right),
-                    method="bounded",
-                    options={"xatol": XATOL_REL * max(right, 1.0)},
-                )
-                cand_w.append(float(res.x))
-                cand_f.append(-float(res.fun))
-    cand_f = [f if np.isfinite(f) else np.inf for f in cand_f]
-    i = int(np.argmax(cand_f))
-    return cand_f[i], cand_w[i]
+def band_grid(poles: np.ndarray, band: tuple[float, float], max_delay: float = 0.0,
+              extra: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """Frequency grid (rad/s) over ``band`` with step ≤ GRID_FACTOR · dist(iΩ, poles) everywhere.
+
+    Built without a loop over points: around each pole s_k = −σ_k + iω_k the points
+    Ω = ω_k + σ_k sinh(u), u on a step of :data:`POLE_STEP`, have step/dist(iΩ, s_k) ≤ 0.222; the
+    union over poles (and a uniform grid for the delay and a 32-point floor) meets the rule for the
+    nearest pole at every Ω ≥ 0.  Any step that still fails is bisected.  The number of points grows
+    with log(band width / modal damping), so lightly damped modes cost little.  Returns the grid and
+    its worst step ratio (see :func:`_step_ratios`; certified when ≤ CERTIFIED_RATIO).
+    """
+    lo, hi = band
+    uniform = (hi - lo) / (4 * MIN_CELL_SAMPLES)
+    if max_delay > 0:
+        uniform = min(uniform, 0.9 * GRID_FACTOR * 2 * np.pi / (4 * max_delay))
+    parts = [np.linspace(lo, hi, int(np.ceil((hi - lo) / uniform)) + 1)]
+    upper = poles[poles.imag >= 0]
+    for s in upper:
+        sigma, omega = abs(s.real), s.imag
+        if sigma == 0:
+            continue
+        u0, u1 = np.arcsinh((lo - omega) / sigma), np.arcsinh((hi - omega) / sigma)
+        u = np.arange(u0, u1 + POLE_STEP, POLE_STEP)
+        parts.append(omega + sigma * np.sinh(u))
+    if extra is not None:
+        parts.append(np.asarray(extra, dtype=float))
+    grid = np.unique(np.clip(np.concatenate(parts), lo, hi))
+    for _ in range(30):  # bisect any step that breaks the rule (rare: only where pole grids thin out)
+        ratios = _step_ratios(grid, poles, max_delay)
+        bad = np.flatnonzero(ratios > CERTIFIED_RATIO)
+        if bad.size == 0 or grid.size > MAX_GRID_POINTS:
+            break
+        grid = np.union1d(grid, 0.5 * (grid[bad] + grid[bad + 1]))
+    return grid, float(np.max(ratios, initial=0.0))

@@ -1,7 +1,8 @@
 """The contract between the CLI and a study kind.
 
 A study is a TOML file whose ``[study]`` table names a ``kind``; each kind registers a pydantic
-config model (the whole file, ``extra="forbid"``) and a ``run`` function.  ``run`` writes its
+config model (the whole file, ``extra="forbid"``) and a ``run`` function with :func:`register_kind`
+when its module in ``railopt.studies.kinds`` is imported.  ``run`` writes its
 files into ``context.outdir`` — a staging folder that the CLI publishes to ``results/<name>/``
 only when the run succeeds, so a failed run leaves nothing half-written.
 """
@@ -29,6 +30,16 @@ def _ordered_interval(v: tuple[float, float]) -> tuple[float, float]:
 
 Interval = Annotated[tuple[float, float], AfterValidator(_ordered_interval)]
 """A (lower, upper) pair with lower < upper, both finite: bounds and frequency bands in configs."""
+
+
+def _non_negative_lower(v: tuple[float, float]) -> tuple[float, float]:
+    if v[0] < 0:
+        raise ValueError(f"lower edge must be ≥ 0 Hz, got {v[0]}")
+    return v
+
+
+BandHz = Annotated[tuple[float, float], AfterValidator(_ordered_interval), AfterValidator(_non_negative_lower)]
+"""A frequency band in Hz: finite, 0 ≤ lower < upper."""
 
 
 class StrictModel(BaseModel):
@@ -70,6 +81,23 @@ class StudyKind:
     config_model: type[BaseModel]
     run: Callable[[BaseModel, StudyContext], StudyOutcome]
     summary: str = ""
+
+
+KINDS: dict[str, StudyKind] = {}
+
+
+def register_kind(kind: StudyKind) -> StudyKind:
+    """Kinds register themselves when their module (in ``railopt.studies.kinds``) is imported."""
+    if kind.name in KINDS and KINDS[kind.name] is not kind:
+        raise ValueError(f"study.kind: {kind.name!r} is registered twice")
+    KINDS[kind.name] = kind
+    return kind
+
+
+class FiniteModel(StrictModel):
+    """A config table whose floats must be finite (NaN and inf are refused naming the field)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def dask_context(context: StudyContext):

@@ -10,7 +10,7 @@ import pandas as pd
 from pydantic import Field, field_validator
 from tqdm import tqdm
 
-from railopt.design import CampaignStore, MinimaxProblem, check_designs, distinct_optima, multistart
+from railopt.design import CampaignStore, MinimaxProblem, check_designs, multistart
 from railopt.design.checks import Check
 from railopt.design.solve import method_options
 from railopt.studies.base import StrictModel, StudyContext
@@ -19,7 +19,7 @@ from railopt.studies.base import StrictModel, StudyContext
 class SolverOptions(StrictModel):
     xtol: float = Field(1e-10, gt=0)
     ftol: float = Field(1e-12, gt=0)
-    maxeval: int = Field(3000, gt=0)
+    maxeval: int = Field(3000, gt=0, strict=True)
     maxtime: float = Field(120.0, gt=0)
 
 
@@ -27,9 +27,9 @@ class CampaignSettings(StrictModel):
     """The ``[design]`` table shared by campaign studies."""
 
     method: Literal["slsqp", "cobyla", "slp"] = "slsqp"
-    n_starts: int = Field(16, gt=0)
+    n_starts: int = Field(16, gt=0, strict=True)
     sampler: Literal["sobol", "lhs"] = "sobol"
-    seed: int = Field(0, ge=0)
+    seed: int = Field(0, ge=0, strict=True)
     options: SolverOptions = SolverOptions()
 
     @field_validator("method")
@@ -99,16 +99,20 @@ def run_campaign(
 
 
 def check_optima(
-    problem: MinimaxProblem,
-    table: pd.DataFrame,
+    optima: pd.DataFrame,
+    variables: list[str],
     label: str,
     context: StudyContext,
     name: str,
     check: Check,
     client: Any = None,
 ) -> pd.DataFrame:
-    """Run ``check`` on the best design of each distinct optimum; results go to the campaign's store."""
-    optima = distinct_optima(table, problem).rename(columns={"best_start": "start_id"})
+    """Run ``check`` on each distinct optimum (rows with ``start_id`` and the variables) as tasks;
+    results go to the campaign's store.  Returns ``optima`` with a column ``name`` (the check's
+    value) and the check's flags (prefixed ``name.`` if a column of that name exists)."""
     with CampaignStore.open(store_path(context, label)) as store:
-        checks = check_designs(check, optima, list(problem.space.names), name, client=client, store=store)
-    return optima.merge(checks, on="start_id", suffixes=("", f"_{name}"))
+        checks = check_designs(check, optima, variables, name, client=client, store=store)
+    checks = checks.drop(columns="name").rename(columns={"value": name})
+    checks = checks.rename(columns={c: f"{name}.{c}" for c in checks.columns
+                                    if c not in ("start_id", name) and c in optima.columns})
+    return optima.merge(checks, on="start_id", how="left")

@@ -1,42 +1,36 @@
-"""Loading and validating a study TOML: every error names the offending field."""
+"""Loading and validating a study TOML: every error names the offending field (and the file)."""
 
 from __future__ import annotations
 
 import importlib
+import pkgutil
 import tomllib
 from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
-from railopt.studies.base import StudyKind
-
-# kind name -> "module:attribute" of its StudyKind, imported on demand
-KINDS: dict[str, str] = {
-    "tmd_hinf": "railopt.studies.tmd_hinf:KIND",
-    "track": "railopt.studies.track:KIND",
-}
+from railopt.studies.base import KINDS, StudyKind
+from railopt.studies.validation import field_errors
 
 
 class ConfigError(ValueError):
     """A study config that cannot be used; the message names the field."""
 
 
+def _import_kinds() -> None:
+    import railopt.studies.kinds as package
+
+    for info in pkgutil.iter_modules(package.__path__):
+        importlib.import_module(f"{package.__name__}.{info.name}")
+
+
 def study_kind(name: str) -> StudyKind:
+    """The registered kind called ``name``."""
+    _import_kinds()
     if name not in KINDS:
         raise ConfigError(f"study.kind: unknown kind {name!r}; known kinds: {sorted(KINDS)}")
-    module, attr = KINDS[name].split(":")
-    return getattr(importlib.import_module(module), attr)
-
-
-def _format_errors(exc: ValidationError) -> str:
-    lines = []
-    for err in exc.errors():
-        loc = ".".join(str(p) for p in err["loc"]) or "(top level)"
-        got = err.get("input")
-        got_text = "" if isinstance(got, dict) else f" (got {got!r})"
-        lines.append(f"{loc}: {err['msg']}{got_text}")
-    return "; ".join(lines)
+    return KINDS[name]
 
 
 def load_study(path: str | Path) -> tuple[StudyKind, BaseModel, dict[str, Any]]:
@@ -45,17 +39,17 @@ def load_study(path: str | Path) -> tuple[StudyKind, BaseModel, dict[str, Any]]:
     if not path.is_file():
         raise ConfigError(f"study: no such file {path}")
     try:
-        raw = tomllib.loads(path.read_text())
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not a text file ({exc.reason} at byte {exc.start})") from None
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
     header = raw.get("study")
     if not isinstance(header, dict) or "kind" not in header:
-        raise ConfigError("study.kind: missing; every study file needs a [study] table with name and kind")
+        raise ConfigError(f"study.kind: missing in {path}; every study file needs a [study] table with name and kind")
     kind = study_kind(str(header["kind"]))
     try:
         config = kind.config_model.model_validate(raw)
-    except ValidationError as exc:
-        raise ConfigError(_format_errors(exc)) from None
-    except ValueError as exc:  # model validators raising plain ValueError
-        raise ConfigError(str(exc)) from None
+    except (ValidationError, ValueError) as exc:  # model validators may raise plain ValueError
+        raise ConfigError(field_errors(exc)) from None
     return kind, config, raw

@@ -29,16 +29,24 @@ def write_study(tmp_path: Path, replace: dict[str, str] | None = None, append: s
 
 
 BAD = {
-    "inverted bounds": ({"tuning_bounds = [0.5, 1.5]": "tuning_bounds = [1.5, 0.5]"}, "", "design.tuning_bounds"),
-    "unknown method": ({'method = "slsqp"': 'method = "newton"'}, "", "design.method"),
+    "inverted bounds": ({"lower = 0.5\nupper = 1.5": "lower = 1.5\nupper = 0.5"}, "", "design.variables.0"),
+    "unknown method": ({'methods = ["slsqp"]': 'methods = ["newton"]'}, "", "design.methods"),
     "n_starts zero": ({"n_starts = 16": "n_starts = 0"}, "", "design.n_starts"),
     "wrong type": ({"n_starts = 16": 'n_starts = "sixteen"'}, "", "design.n_starts"),
-    "inverted band": ({"band_ratio = [0.5, 1.5]": "band_ratio = [1.5, 0.5]"}, "", "model.band_ratio"),
-    "nan mass ratio": ({"mass_ratios = [0.05, 0.1]": "mass_ratios = [nan, 0.1]"}, "", "model.mass_ratios"),
+    "inverted band": ({"band_hz = [1.0, 3.0]": "band_hz = [3.0, 1.0]"}, "", "objective.band_hz"),
+    "nan mass ratio": ({"mass_ratio = 0.05,": "mass_ratio = nan,"}, "", "models[0].options.mass_ratio"),
+    "huge mass ratio": ({"mass_ratio = 0.05,": "mass_ratio = 1e308,"}, "", "models[0].options.mass_ratio"),
     "unknown field": ({}, "\n[extra]\nfoo = 1\n", "extra"),
     "unknown option": ({"maxtime = 120.0": "maxtime = 120.0\nmax_time = 5"}, "", "design.options.max_time"),
-    "unknown kind": ({'kind = "tmd_hinf"': 'kind = "tmd"'}, "", "study.kind"),
+    "unknown kind": ({'kind = "campaign"': 'kind = "tmd"'}, "", "study.kind"),
     "negative time": ({"maxtime = 120.0": "maxtime = -1.0"}, "", "design.options.maxtime"),
+    "unknown variable": ({'name = "tuning"': 'name = "stiffness"'}, "", "design.variables"),
+    "unknown output": ({'output = "amplification"': 'output = "stroke"'}, "", "objective.output"),
+    "repeated label": ({'label = "mu0.1"': 'label = "mu0.05"'}, "", "models: labels must be unique"),
+    "unknown model": ({'model = "tmd"': 'model = "tdm"'}, "", "models[0].model"),
+    "unknown named start": ({'start_from = ["den_hartog"]': 'start_from = ["existing"]'}, "", "design.start_from"),
+    "unknown check": ({'checks = ["spectral_abscissa"]': 'checks = ["hunting"]'}, "", "design.checks"),
+    "bool for an int": ({"n_starts = 16": "n_starts = true"}, "", "design.n_starts"),
 }
 
 
@@ -60,9 +68,12 @@ def test_missing_study_file(tmp_path, capsys):
 
 
 def small_study(tmp_path: Path, n_starts: int = 6, objectives: str = '["exact"]') -> Path:
-    return write_study(tmp_path, {"n_starts = 16": f"n_starts = {n_starts}",
-                                  'objectives = ["thesis", "exact"]': f"objectives = {objectives}",
-                                  "mass_ratios = [0.05, 0.1]": "mass_ratios = [0.05]"})
+    study = write_study(tmp_path, {"n_starts = 16": f"n_starts = {n_starts}",
+                                   'objectives = ["thesis", "exact"]': f"objectives = {objectives}"})
+    text = study.read_text()
+    second = text.index("[[models]]", text.index("[[models]]") + 1)
+    study.write_text(text[:second] + text[text.index("[objective]"):])  # one model: mu0.05
+    return study
 
 
 def test_run_publishes_results_and_refuses_to_overwrite_a_store(tmp_path, capsys):
@@ -74,18 +85,18 @@ def test_run_publishes_results_and_refuses_to_overwrite_a_store(tmp_path, capsys
         assert (out / name).is_file(), name
     assert not list(results.glob(".staging-*"))
     comparison = pd.read_csv(out / "comparison.csv")
-    assert abs(comparison["peak_rel_err_vs_NA"].iloc[0]) < 1e-4
-    before = (out / "campaigns" / "mu0.05-exact.sqlite").read_bytes()
+    assert abs(comparison["rel_err_vs_nishihara_asami"].iloc[0]) < 1e-4
+    before = (out / "campaigns" / "mu0.05-exact-slsqp.sqlite").read_bytes()
     assert main(["run", str(study), "--results", str(results), "--workers", "0", "--no-progress"]) == 2
     assert "--resume" in capsys.readouterr().err
-    assert (out / "campaigns" / "mu0.05-exact.sqlite").read_bytes() == before  # nothing lost
+    assert (out / "campaigns" / "mu0.05-exact-slsqp.sqlite").read_bytes() == before  # nothing lost
 
 
 @pytest.mark.slow
 def test_killed_campaign_resumes_with_every_start_exactly_once(tmp_path):
     study = small_study(tmp_path, n_starts=48, objectives='["exact"]')
     results = tmp_path / "results"
-    store = results / "tmd_hinf" / "campaigns" / "mu0.05-exact.sqlite"
+    store = results / "tmd_hinf" / "campaigns" / "mu0.05-exact-slsqp.sqlite"
     cmd = [sys.executable, "-m", "railopt.studies.cli", "run", str(study), "--results", str(results),
            "--workers", "0", "--no-progress"]
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}

@@ -63,9 +63,11 @@ def test_same_seed_same_starts_and_user_points_first():
 def test_bad_campaign_arguments_name_the_field(field, kwargs, tmp_path):
     args = {"n_starts": 4, **kwargs}
     path = tmp_path / "c.sqlite"
+    store = CampaignStore.create(path, "c", {}, ["x1", "x2"])
     with pytest.raises(ValueError, match="^" + re.escape(field) + ":"):
-        multistart(double_well(), **args)
-    assert not path.exists()
+        multistart(double_well(), store=store, **args)
+    assert store.starts().empty  # refused before any start was written
+    store.close()
 
 
 def test_distinct_optima_are_clustered():
@@ -139,9 +141,12 @@ def test_local_cluster_gives_the_serial_table(client):
 
 def test_local_cluster_gives_the_serial_table_for_a_lapack_model(client):
     """Eigen-decompositions and complex solves round identically in workers and in-process."""
-    from railopt.studies.tmd_hinf import TMDDesign, TMDModel, tmd_problem
+    from railopt.studies.cli import STUDIES_DIR
+    from railopt.studies.config import load_study
+    from railopt.studies.kinds.campaign import campaign_problem
 
-    problem = tmd_problem(0.05, TMDModel(), TMDDesign(), exact=True)
+    _, config, _ = load_study(STUDIES_DIR / "tmd_hinf.toml")
+    problem = campaign_problem(config, config.setups()["mu0.05"], "exact")
     serial = multistart(problem, 8, seed=2002)
     parallel = multistart(problem, 8, seed=2002, client=client)
     cols = [c.replace("x1", "tuning").replace("x2", "damping_ratio") for c in DETERMINISTIC]

@@ -8,7 +8,7 @@ import pytest
 from pydantic import ValidationError
 
 from railopt.studies.base import StudyContext
-from railopt.studies.track import KIND, TrackStudyConfig
+from railopt.studies.kinds.track import KIND, TrackStudyConfig
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -25,10 +25,11 @@ from dataclasses import asdict, dataclass
 import pandas as pd
 
 from railopt.models.track.beam import Beam
+from railopt.records import ArrayRecord
 
 
-@dataclass(frozen=True)
-class LumpedTrack:
+@dataclass(frozen=True, eq=False, repr=False)
+class LumpedTrack(ArrayRecord):
     """Lumped track parameters (SI).
 
     Attributes

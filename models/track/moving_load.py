@@ -32,9 +32,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy import integrate, optimize
+from scipy import integrate
 
+from railopt.models.peak_search import grid_maximum
 from railopt.models.track.beam import Beam
+from railopt.records import ArrayRecord
 
 _METHODS = ("closed", "fourier")
 
@@ -88,8 +90,8 @@ def characteristic_roots(beam: Beam, v: float) -> np.ndarray:
     return r[np.argsort(r.real)]
 
 
-@dataclass(frozen=True)
-class ClosedFormSolution:
+@dataclass(frozen=True, eq=False, repr=False)
+class ClosedFormSolution(ArrayRecord):
     """The closed-form steady state as sums of exponentials (A.2.10).
 
     ``y(ξ) = Σ A_j exp(r_j ξ)`` for ξ > 0 (``roots_ahead``, Re r < 0) and
@@ -294,8 +296,8 @@ def fourier_deflection(beam: Beam, xi: np.ndarray | float, P: float, v: float) -
 
 
 # --- results -------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class MovingLoadSolution:
+@dataclass(frozen=True, eq=False, repr=False)
+class MovingLoadSolution(ArrayRecord):
     """Steady-state deflection under a moving load.
 
     Attributes
@@ -343,43 +345,19 @@ class MovingLoadSolution:
 
 
 def _maximum_closed(sol: ClosedFormSolution, beam: Beam) -> tuple[float, float]:
+    """Maximum of the closed-form profile: a grid resolving the shortest wave, then the peak search."""
     b = beam.beta
     decay = min(np.min(np.abs(sol.roots_ahead.real)), np.min(np.abs(sol.roots_behind.real)))
     width = min(max(6.0 / b, 3.0 / max(decay, 1e-300)), 60.0 / b)
     wave = max(np.max(np.abs(sol.roots_ahead.imag)), np.max(np.abs(sol.roots_behind.imag)), b)
     n = int(min(max(2001, 2.0 * width * wave / (2.0 * math.pi) * 60), 200_001))
-    grid = np.linspace(-width, width, n)
-    vals = sol.evaluate(grid)
-    i = int(np.argmax(vals))
-    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, n - 1)]
-
-    def slope(x: float) -> float:
-        return float(sol.evaluate(np.array([x]), 1)[0])
-
-    # y' is continuous (only y''' jumps at the load): refine the stationary point by bracketing
-    if slope(lo) > 0.0 > slope(hi):
-        x_best = optimize.brentq(slope, lo, hi, xtol=1e-14 / b, rtol=1e-14)
-    else:
-        x_best = float(grid[i])
-    y_best = float(sol.evaluate(np.array([x_best]))[0])
-    if y_best < vals[i]:
-        x_best, y_best = float(grid[i]), float(vals[i])
-    return float(x_best), y_best
+    return grid_maximum(sol.evaluate, np.linspace(-width, width, n), rtol=1e-10)
 
 
 def _maximum_fourier(beam: Beam, P: float, v: float) -> tuple[float, float]:
+    """Maximum of the Fourier-integral profile (each point a quadrature: a coarse grid, then refined)."""
     b = beam.beta
-    grid = np.linspace(-4.0 / b, 4.0 / b, 33)
-    vals = fourier_deflection(beam, grid, P, v)
-    i = int(np.argmax(vals))
-    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
-    res = optimize.minimize_scalar(
-        lambda x: -float(fourier_deflection(beam, np.array([x]), P, v)[0]),
-        bounds=(lo, hi),
-        method="bounded",
-        options={"xatol": 1e-7 / b},
-    )
-    return float(res.x), float(-res.fun)
+    return grid_maximum(lambda x: fourier_deflection(beam, x, P, v), np.linspace(-4.0 / b, 4.0 / b, 33), rtol=1e-7)
 
 
 def moving_load(

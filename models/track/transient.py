@@ -37,6 +37,7 @@ import pandas as pd
 from scipy import special
 
 from railopt.models.track.beam import Beam, _check_finite
+from railopt.records import ArrayRecord
 
 
 @dataclass(frozen=True)
@@ -112,8 +113,8 @@ class DistributedImpulse:
 Load = MovingLoad | ImpulseLoad | DistributedImpulse
 
 
-@dataclass(frozen=True)
-class TransientSolution:
+@dataclass(frozen=True, eq=False, repr=False)
+class TransientSolution(ArrayRecord):
     """Deflection ``y[i, j] = y(x[j], t[i])``, m; ``x`` in m, ``t`` in s."""
 
     x: np.ndarray

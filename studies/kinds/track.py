@@ -8,6 +8,7 @@ returns a summary table and markdown.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Literal
 
@@ -31,9 +32,9 @@ from railopt.models.track import (
     transient,
 )
 from railopt.models.track.parameters import RAILS
-from railopt.models.track.plots import Curve, plot_amplification, plot_profiles, plot_time_histories
 from railopt.models.track.units import INCH, MPH, POUND_FORCE, PSI
-from railopt.studies.base import StrictModel, StudyContext, StudyHeader, StudyKind, StudyOutcome
+from railopt.studies.base import StrictModel, StudyContext, StudyHeader, StudyKind, StudyOutcome, register_kind
+from railopt.studies.figures import Curve, plot_amplification, plot_profiles, plot_time_histories
 
 FigureName = Literal[
     "fig3_3_impulse",
@@ -117,7 +118,9 @@ class TrackStudyConfig(StrictModel):
     @model_validator(mode="after")
     def _check(self) -> TrackStudyConfig:
         if self.study.kind != "track":
-            raise ValueError(f"study.kind must be 'track' for this config model, got {self.study.kind!r}")
+            raise ValueError(f"study.kind: must be 'track' for this config model, got {self.study.kind!r}")
+        if "amplification" in self.figures.make and self.amplification is None:
+            raise ValueError("figures.make: lists 'amplification' but the [amplification] table is missing")
         Beam(EI=self.track.EI_N_m2, m=self.track.m_kg_m, k=self.track.k_N_m2)
         return self
 
@@ -310,102 +313,93 @@ def run(config: TrackStudyConfig, context: StudyContext) -> StudyOutcome:
     }
     out.table(lt.to_pandas(), "lumped")
     out.table(f0_table(), "f0_choices")
-    ml = cfg.moving_load
     maxima: list[dict] = []
-    vcr = beam.critical_velocity()
-
-    def ratios(zeta: float, nu: float) -> Beam:
-        return Beam.from_ratios(beam.EI, beam.m, beam.k, damping_ratio=zeta, axial_ratio=nu)
-
     for name in cfg.figures.make:
-        if name == "fig3_3_impulse":
-            summary.update(_fig_impulse(cfg, beam, out))
-        elif name == "fig3_4_step":
-            summary.update(_fig_step(cfg, beam, out))
-        elif name == "fig3_5_damping":
-            beams = [ratios(z, 0.0) for z in ml.damping_ratios]
-            maxima += _profiles_figure(
-                cfg,
-                out,
-                name,
-                f"Fig 3.5 — effect of damping, N = 0, v/v_cr = {ml.speed_ratio:g}",
-                beams,
-                [f"c/c_cr = {z:g}" for z in ml.damping_ratios],
-                [ml.speed_ratio * b.critical_velocity() for b in beams],
-            )
-        elif name == "fig3_6_damping_axial":
-            beams = [ratios(z, ml.axial_ratio_fig3_6) for z in ml.damping_ratios]
-            maxima += _profiles_figure(
-                cfg,
-                out,
-                name,
-                f"Fig 3.6 — effect of damping, N/N_cr = {ml.axial_ratio_fig3_6:g}, "
-                f"v/v_cr(N=0) = {ml.speed_ratio:g}",
-                beams,
-                [f"c/c_cr = {z:g}" for z in ml.damping_ratios],
-                [ml.speed_ratio * vcr] * len(beams),
-            )
-        elif name == "fig3_7_axial":
-            beams = [ratios(ml.damping_ratio_fig3_7, nu) for nu in ml.axial_ratios]
-            maxima += _profiles_figure(
-                cfg,
-                out,
-                name,
-                f"Fig 3.7 — effect of axial force (+ compression), c/c_cr = {ml.damping_ratio_fig3_7:g}, "
-                f"v/v_cr(N=0) = {ml.speed_ratio:g}",
-                beams,
-                [f"N/N_cr = {nu:+g}" for nu in ml.axial_ratios],
-                [ml.speed_ratio * vcr] * len(beams),
-            )
-        elif name in ("fig3_8_velocity_damped", "fig3_9_velocity_undamped"):
-            zeta = ml.damping_ratio_fig3_8 if name == "fig3_8_velocity_damped" else 0.0
-            beams = [ratios(zeta, 0.0)] * len(ml.speed_ratios)
-            label = "Fig 3.8" if zeta > 0 else "Fig 3.9"
-            maxima += _profiles_figure(
-                cfg,
-                out,
-                name,
-                f"{label} — effect of velocity, c/c_cr = {zeta:g}, N = 0",
-                beams,
-                [f"v/v_cr = {th:g} ({th * vcr / MPH:.0f} mph)" for th in ml.speed_ratios],
-                [th * vcr for th in ml.speed_ratios],
-            )
-        elif name == "accelerating":
-            summary.update(_fig_accelerating(cfg, beam, out))
-        elif name == "oscillating":
-            summary.update(_fig_oscillating(cfg, beam, out))
-        elif name == "amplification":
-            if cfg.amplification is None:
-                raise ValueError(
-                    "figures.make lists 'amplification' but the [amplification] table is missing"
-                )
-    if cfg.amplification is not None:
-        am = cfg.amplification
-        table = dynamic_amplification(
-            beam.EI, beam.m, beam.k, tk.P_N, am.speed_ratios, am.damping_ratios, am.axial_ratios
-        )
-        table["y_max_in"] = table["y_max_m"] / INCH
-        table["x_max_in"] = table["x_max_m"] / INCH
-        out.table(table, "amplification")
-        if "amplification" in cfg.figures.make:
-            theta = np.linspace(0.0, 1.6, 161)
-            fine = dynamic_amplification(
-                beam.EI, beam.m, beam.k, tk.P_N, theta, [z for z in am.damping_ratios if z > 0], [0.0]
-            )
-            curves = [
-                (f"c/c_cr = {z:g}", g["speed_amplification"].to_numpy())
-                for z, g in fine.groupby("damping_ratio")
-            ]
-            out.figure(
-                plot_amplification(theta, curves, "Dynamic amplification of the maximum deflection, N = 0"),
-                "amplification",
-            )
+        if name in PROFILE_FIGURES:
+            maxima += _profiles_figure(cfg, out, name, *PROFILE_FIGURES[name](cfg, beam))
+        else:
+            summary.update(OTHER_FIGURES[name](cfg, beam, out))
+    if cfg.amplification is not None and "amplification" not in cfg.figures.make:
+        _amplification(cfg, beam, out)  # the table alone
     if maxima:
         out.table(pd.DataFrame(maxima), "maxima")
     summary_df = pd.DataFrame([{"quantity": k, "value": v} for k, v in summary.items()])
     out.table(summary_df, "summary")
     md = _markdown(cfg, summary, maxima, out.files)  # the CLI writes it as summary.md
     return StudyOutcome(table=summary_df, markdown=md, files=out.files)
+
+
+def _amplification(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
+    """Dynamic-amplification table over v/v_cr, c/c_cr, N/N_cr and, when asked, its figure."""
+    am, P = cfg.amplification, cfg.track.P_N
+    table = dynamic_amplification(beam.EI, beam.m, beam.k, P, am.speed_ratios, am.damping_ratios, am.axial_ratios)
+    table["y_max_in"] = table["y_max_m"] / INCH
+    table["x_max_in"] = table["x_max_m"] / INCH
+    out.table(table, "amplification")
+    if "amplification" in cfg.figures.make:
+        theta = np.linspace(0.0, 1.6, 161)
+        fine = dynamic_amplification(beam.EI, beam.m, beam.k, P, theta, [z for z in am.damping_ratios if z > 0], [0.0])
+        curves = [(f"c/c_cr = {z:g}", g["speed_amplification"].to_numpy()) for z, g in fine.groupby("damping_ratio")]
+        out.figure(plot_amplification(theta, curves, "Dynamic amplification of the maximum deflection, N = 0"),
+                   "amplification")
+    return {}
+
+
+def _ratios(beam: Beam, zeta: float, nu: float) -> Beam:
+    return Beam.from_ratios(beam.EI, beam.m, beam.k, damping_ratio=zeta, axial_ratio=nu)
+
+
+def _fig3_5(cfg: TrackStudyConfig, beam: Beam):
+    ml = cfg.moving_load
+    beams = [_ratios(beam, z, 0.0) for z in ml.damping_ratios]
+    return (f"Fig 3.5 — effect of damping, N = 0, v/v_cr = {ml.speed_ratio:g}", beams,
+            [f"c/c_cr = {z:g}" for z in ml.damping_ratios], [ml.speed_ratio * b.critical_velocity() for b in beams])
+
+
+def _fig3_6(cfg: TrackStudyConfig, beam: Beam):
+    ml = cfg.moving_load
+    beams = [_ratios(beam, z, ml.axial_ratio_fig3_6) for z in ml.damping_ratios]
+    return (f"Fig 3.6 — effect of damping, N/N_cr = {ml.axial_ratio_fig3_6:g}, v/v_cr(N=0) = {ml.speed_ratio:g}",
+            beams, [f"c/c_cr = {z:g}" for z in ml.damping_ratios],
+            [ml.speed_ratio * beam.critical_velocity()] * len(beams))
+
+
+def _fig3_7(cfg: TrackStudyConfig, beam: Beam):
+    ml = cfg.moving_load
+    beams = [_ratios(beam, ml.damping_ratio_fig3_7, nu) for nu in ml.axial_ratios]
+    return (f"Fig 3.7 — effect of axial force (+ compression), c/c_cr = {ml.damping_ratio_fig3_7:g}, "
+            f"v/v_cr(N=0) = {ml.speed_ratio:g}", beams, [f"N/N_cr = {nu:+g}" for nu in ml.axial_ratios],
+            [ml.speed_ratio * beam.critical_velocity()] * len(beams))
+
+
+def _velocity(zeta_of: Callable[[MovingLoadTable], float], label: str):
+    def spec(cfg: TrackStudyConfig, beam: Beam):
+        ml, vcr = cfg.moving_load, beam.critical_velocity()
+        zeta = zeta_of(ml)
+        beams = [_ratios(beam, zeta, 0.0)] * len(ml.speed_ratios)
+        return (f"{label} — effect of velocity, c/c_cr = {zeta:g}, N = 0", beams,
+                [f"v/v_cr = {th:g} ({th * vcr / MPH:.0f} mph)" for th in ml.speed_ratios],
+                [th * vcr for th in ml.speed_ratios])
+
+    return spec
+
+
+# the figures a config can ask for: moving-load profile figures (title, beams, labels, speeds) …
+PROFILE_FIGURES: dict[str, Callable] = {
+    "fig3_5_damping": _fig3_5,
+    "fig3_6_damping_axial": _fig3_6,
+    "fig3_7_axial": _fig3_7,
+    "fig3_8_velocity_damped": _velocity(lambda ml: ml.damping_ratio_fig3_8, "Fig 3.8"),
+    "fig3_9_velocity_undamped": _velocity(lambda ml: 0.0, "Fig 3.9"),
+}
+# … and figures drawn by their own builder (cfg, beam, writer) -> summary entries
+OTHER_FIGURES: dict[str, Callable] = {
+    "fig3_3_impulse": _fig_impulse,
+    "fig3_4_step": _fig_step,
+    "accelerating": _fig_accelerating,
+    "oscillating": _fig_oscillating,
+    "amplification": _amplification,
+}
 
 
 def _markdown(cfg: TrackStudyConfig, s: dict, maxima: list[dict], files: list[str]) -> str:
@@ -441,9 +435,9 @@ def _markdown(cfg: TrackStudyConfig, s: dict, maxima: list[dict], files: list[st
     return "\n".join(lines) + "\n"
 
 
-KIND = StudyKind(
+KIND = register_kind(StudyKind(
     name="track",
     config_model=TrackStudyConfig,
     run=run,
     summary="Track beam on a Kelvin foundation: Figs 3.3–3.9, amplification, lumped track (thesis Ch. 3)",
-)
+))

@@ -1,8 +1,8 @@
-"""Figures of the track studies (Figs 3.3–3.9 style).  These functions only draw data they are given.
+"""Every figure of the studies.  These functions only draw data they are given; models never draw.
 
-Deflection is plotted positive downward (the rail sinks under the wheel), distance along the track
-with the load at 0, ahead to the right.  ``units="inch-pound"`` shows inches (the thesis's units),
-``"SI"`` shows metres and millimetres.
+Track figures (Figs 3.3–3.9 style): deflection is plotted positive downward (the rail sinks under
+the wheel), distance along the track with the load at 0, ahead to the right.
+``units="inch-pound"`` shows inches (the thesis's units), ``"SI"`` metres and millimetres.
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 from matplotlib.figure import Figure
 
 from railopt.models.track.units import INCH
@@ -30,7 +31,7 @@ class Curve:
 
 def _scales(units: str) -> tuple[float, str, float, str]:
     if units not in _UNITS:
-        raise ValueError(f"units must be one of {_UNITS}, got {units!r}")
+        raise ValueError(f"units: must be one of {_UNITS}, got {units!r}")
     if units == "inch-pound":
         return 1.0 / INCH, "in", 1.0 / INCH, "in"
     return 1.0, "m", 1000.0, "mm"
@@ -127,6 +128,61 @@ def plot_amplification(
     ax.set_ylabel("y_max / y_static")
     ax.set_title(title, fontsize=10)
     ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+FRF_STYLES = {"ref": ("k", "-", 2.5, 0.35), "exact": ("C0", "-", 1.3, 1.0), "thesis": ("C3", "--", 1.2, 1.0)}
+
+
+def plot_frf_panels(panels: Sequence[tuple[str, str, Sequence[tuple[str, np.ndarray, np.ndarray, str]]]]) -> Figure:
+    """One panel per (title, y label, curves); a curve is (label, frequency in Hz, |H|, style key).
+
+    Style keys: ``"ref"`` (named designs: wide grey), ``"exact"``, ``"thesis"`` (optima of the two
+    objectives); any other key cycles through matplotlib's colours.
+    """
+    fig = Figure(figsize=(6.2 * len(panels), 4.3))
+    axes = fig.subplots(1, len(panels), squeeze=False)[0]
+    for ax, (title, ylabel, curves) in zip(axes, panels, strict=True):
+        for i, (label, f_hz, mag, key) in enumerate(curves):
+            color, ls, lw, alpha = FRF_STYLES.get(key, (f"C{i % 10}", "-", 1.2, 1.0))
+            ax.plot(f_hz, mag, color=color, ls=ls, lw=lw, alpha=alpha, label=label)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("forcing frequency (Hz)")
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame) -> Figure:
+    """Fig 4.4 style: roots in the complex plane coloured by speed, one panel per model; and the
+    least damping ratio against speed."""
+    models = list(dict.fromkeys(locus["model"]))
+    fig = Figure(figsize=(5.2 * (len(models) + 1), 4.4))
+    axes = fig.subplots(1, len(models) + 1, squeeze=False)[0]
+    for ax, m in zip(axes, models, strict=False):
+        d = locus[(locus["model"] == m) & (locus["frequency_hz"] < 25)]
+        sc = ax.scatter(d["real"], d["frequency_hz"], c=d["speed"], s=3, cmap="viridis")
+        ax.axvline(0.0, color="k", lw=0.8)
+        cs = critical[critical["model"] == m].iloc[0]
+        ax.set_title(f"{m}: critical {cs['critical_speed_m_s']:.2f} m/s ({cs['critical_speed_mph']:.1f} mph)",
+                     fontsize=9)
+        ax.set_xlabel("Re s (1/s)")
+        ax.set_ylabel("Im s / 2π (Hz)")
+        ax.set_xlim(max(d["real"].min(), -15.0), max(d["real"].max() * 1.2, 1.0))
+        ax.grid(alpha=0.3)
+        fig.colorbar(sc, ax=ax, label="speed (m/s)")
+    ax = axes[-1]
+    for m in models:
+        g = locus[locus["model"] == m].groupby("speed")["damping_ratio"].min()
+        ax.plot(g.index, g.to_numpy(), label=m)
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("speed (m/s)")
+    ax.set_ylabel("least damping ratio")
+    ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig

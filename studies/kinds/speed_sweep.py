@@ -1,0 +1,156 @@
+"""Study kind ``speed_sweep``: roots against forward speed, critical speeds, damping, sensitivities.
+
+For each model with forward speed (``[[models]]`` naming e.g. ``vehicle_lateral``): the velocity
+root locus over ``[speeds]`` (Fig 4.4), the least damping ratio and the spectral abscissa at each
+speed, and the critical speed (lowest S with a root in Re s > 0, bracketed and refined by Brent's
+method to a tolerance, §4.3.1, (4.51)–(4.59)).  Optional ``[[sensitivity]]`` tables repeat the
+critical-speed search with one vehicle parameter scaled by each factor.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar
+
+import numpy as np
+import pandas as pd
+from pydantic import Field, field_validator, model_validator
+
+from railopt.models.stability import critical_speed, root_locus
+from railopt.studies.base import (
+    FiniteModel,
+    Interval,
+    StudyContext,
+    StudyKind,
+    StudyOutcome,
+    register_kind,
+)
+from railopt.studies.catalog import ModelRef, ModelSetup, ModelsStudy
+from railopt.studies.figures import plot_root_locus
+from railopt.studies.report import markdown_table, write_table
+
+MPH = 0.44704
+
+
+class SpeedGrid(FiniteModel):
+    range_m_s: Interval
+    points: int = Field(100, ge=2, le=20_000, strict=True)
+
+    @field_validator("range_m_s")
+    @classmethod
+    def _positive(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if v[0] <= 0:
+            raise ValueError(f"speeds must be positive, got lower {v[0]} m/s")
+        return v
+
+    def speeds(self) -> np.ndarray:
+        return np.linspace(*self.range_m_s, self.points)
+
+
+class CriticalSpec(SpeedGrid):
+    """Critical-speed search: bracketing grid of ``points`` speeds, then Brent to ``tol_m_s``."""
+
+    points: int = Field(8, ge=2, le=10_000, strict=True)
+    tol_m_s: float = Field(0.01, gt=0)
+
+
+class SensitivitySpec(FiniteModel):
+    parameter: str
+    factors: list[float] = Field(min_length=1)
+
+    @field_validator("factors")
+    @classmethod
+    def _positive(cls, v: list[float]) -> list[float]:
+        if any(f <= 0 for f in v):
+            raise ValueError(f"factors must be positive, got {v}")
+        return v
+
+
+class SpeedSweepConfig(ModelsStudy):
+    KIND: ClassVar[str] = "speed_sweep"
+    speeds: SpeedGrid
+    critical: CriticalSpec
+    sensitivity: list[SensitivitySpec] = Field(default_factory=list)
+    dpi: int = Field(110, ge=50, le=300, strict=True)
+
+    @model_validator(mode="after")
+    def _resolve(self) -> SpeedSweepConfig:
+        for i, ref in enumerate(self.models):
+            setup = ref.setup(f"models[{i}]")
+            if setup.speed_model is None:
+                raise ValueError(f"models[{i}].model: {ref.model!r} has no forward speed; use a vehicle model")
+            for j, sens in enumerate(self.sensitivity):
+                _variant(ref, sens.parameter, sens.factors[0], f"sensitivity[{j}]")
+        return self
+
+
+def _variant(ref: ModelRef, parameter: str, factor: float, where: str) -> ModelSetup:
+    """The model with one vehicle parameter scaled by ``factor`` (through the ``parameters`` option)."""
+    options = ref.validated_options(where)
+    if "parameters" not in type(options).model_fields:
+        raise ValueError(f"{where}.parameter: model {ref.model!r} takes no parameter overrides")
+    from railopt.models.vehicle import load_vehicle
+
+    vehicle = load_vehicle(options.vehicle).with_parameters(options.parameters)
+    try:
+        base = vehicle.parameter(parameter)
+    except ValueError as exc:
+        raise ValueError(f"{where}.parameter: {exc}") from None
+    changed = {**options.parameters, parameter: factor * base}
+    return ref.model_copy(update={"options": {**ref.options, "parameters": changed}}).setup(where)
+
+
+def _critical_row(label: str, setup: ModelSetup, spec: CriticalSpec) -> dict:
+    cs = critical_speed(setup.speed_model(setup.defaults), speed_range=spec.range_m_s, tol=spec.tol_m_s,
+                        grid=spec.points)
+    return {"model": label, "critical_speed_m_s": cs.speed, "critical_speed_mph": cs.speed / MPH,
+            "hunting_frequency_hz": cs.frequency, "mode": cs.mode, "eigen_solves": cs.eigen_solves,
+            "unstable_at_lower_end": cs.unstable_at_lower_end, "stable_over_range": math.isinf(cs.speed),
+            "tol_m_s": cs.tol}
+
+
+def run(config: SpeedSweepConfig, context: StudyContext) -> StudyOutcome:
+    cfg = config
+    loci, critical, damping, sens_rows = [], [], [], []
+    for i, ref in enumerate(cfg.models):
+        setup = ref.setup(f"models[{i}]")
+        model = setup.speed_model(setup.defaults)
+        locus = root_locus(model, speeds=cfg.speeds.speeds()).assign(model=ref.label)
+        loci.append(locus)
+        g = locus.groupby("speed")
+        damping.append(pd.DataFrame({"model": ref.label, "speed_m_s": g["real"].max().index,
+                                     "spectral_abscissa": g["real"].max().to_numpy(),
+                                     "least_damping_ratio": g["damping_ratio"].min().to_numpy()}))
+        critical.append(_critical_row(ref.label, setup, cfg.critical))
+        for j, sens in enumerate(cfg.sensitivity):
+            for factor in sens.factors:
+                row = _critical_row(ref.label, _variant(ref, sens.parameter, factor, f"sensitivity[{j}]"),
+                                    cfg.critical)
+                sens_rows.append({"parameter": sens.parameter, "factor": factor, **row})
+    locus_table = pd.concat(loci, ignore_index=True)
+    critical_table = pd.DataFrame(critical)
+    files = write_table(locus_table, context.outdir, "root_locus")
+    files += write_table(critical_table, context.outdir, "critical_speeds")
+    files += write_table(pd.concat(damping, ignore_index=True), context.outdir, "damping")
+    sens_table = pd.DataFrame(sens_rows)
+    if len(sens_table):
+        files += write_table(sens_table, context.outdir, "sensitivity")
+    fig = plot_root_locus(locus_table, critical_table)
+    fig.savefig(context.outdir / "root_locus.png", dpi=cfg.dpi)
+    files.append("root_locus.png")
+    lines = [f"# {cfg.study.name}", "", cfg.study.description, "",
+             f"Root locus over {cfg.speeds.range_m_s[0]:g}–{cfg.speeds.range_m_s[1]:g} m/s; critical speed searched "
+             f"in {cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s to ±{cfg.critical.tol_m_s:g} m/s.",
+             "", markdown_table(critical_table), ""]
+    if len(sens_table):
+        lines += ["Sensitivity of the critical speed:", "", markdown_table(sens_table.drop(columns=["tol_m_s"])), ""]
+    lines += ["![root locus](root_locus.png)", ""]
+    return StudyOutcome(table=critical_table, markdown="\n".join(lines), files=files)
+
+
+KIND = register_kind(StudyKind(
+    name="speed_sweep",
+    config_model=SpeedSweepConfig,
+    run=run,
+    summary="root locus, critical speed and sensitivities over forward speed",
+))
