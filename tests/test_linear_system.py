@@ -100,3 +100,28 @@ def test_bad_shapes_and_response_are_rejected():
         LinearSystem(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], [1.0, 0.0], response="jerk")
     with pytest.raises(ValueError, match="^M:"):
         LinearSystem(np.zeros((2, 2)), np.eye(2), np.eye(2), [1.0, 0.0], [1.0, 0.0])
+
+
+@pytest.mark.parametrize("field", ["M", "C", "K"])
+def test_complex_matrix_is_an_error_not_a_dropped_imaginary_part(field):
+    mats = {"M": np.eye(2), "C": np.eye(2), "K": np.eye(2)}
+    mats[field] = mats[field] + 1e-3j
+    with pytest.raises(ValueError, match=f"^{field}: must be real"):
+        LinearSystem(mats["M"], mats["C"], mats["K"], [1.0, 0.0], [1.0, 0.0])
+
+
+def test_empty_system_complex_output_and_band_of_three_name_the_field():
+    with pytest.raises(ValueError, match="^M: must be a non-empty square matrix"):
+        LinearSystem(np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0)), [], [])
+    with pytest.raises(ValueError, match="^output: must be real"):
+        LinearSystem(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], [1.0 + 1j, 0.0])
+    sys = LinearSystem([[1.0]], [[0.1]], [[1.0]], [1.0], [1.0])
+    with pytest.raises(ValueError, match="^band: must be a pair"):
+        sys.response_maxima((0.0, 1.0, 2.0))
+
+
+def test_numpy_scalars_are_accepted_where_numbers_are():
+    sys = LinearSystem([[1.0]], [[0.1]], [[1.0]], [1.0], [1.0])
+    a = sys.response_maxima((np.float32(0.0), np.int64(2)), exact=True)
+    b = sys.response_maxima((0.0, 2.0), exact=True)
+    assert a == b

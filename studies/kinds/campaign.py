@@ -255,6 +255,12 @@ def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, model: str, obj
     return row
 
 
+def _main_columns(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
+    cols = ["model", "objective", "method", *names, "U_objective", "true_peak", "objective_underestimate",
+            "converged", "starts", "distinct_optima", "evaluations", "wall_time_s", "all_optima_pass_checks"]
+    return comparison[[c for c in cols if c in comparison.columns]]
+
+
 def _short(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
     cols = ["model", "objective", "method", *names, "U_objective", "true_peak", "converged", "starts",
             "distinct_optima"]
@@ -307,7 +313,16 @@ def _markdown(cfg: CampaignStudyConfig, comparison: pd.DataFrame, names: list[st
         "band edges); `exact` minimises the certified band maximum. `true_peak` is the certified band maximum",
         "at the best design found; `objective_underestimate` is how far the minimised value lies below it.",
         "",
-        markdown_table(comparison),
+        markdown_table(_main_columns(comparison, names)),
+        "",
+    ]
+    for ref in cfg.report.compare:
+        cols = ["model", "objective", "method", f"{ref}_peak", f"rel_err_vs_{ref}"]
+        cols += [f"{n}_err_vs_{ref}" for n in names]
+        lines += [f"Against `{ref}` (its certified peak, and the best design's differences):", "",
+                  markdown_table(comparison[[c for c in cols if c in comparison.columns]]), ""]
+    lines += [
+        "Per campaign: evaluations and wall time are sums over its starts; `comparison.csv` has every column.",
         "",
         "![FRF at the optima](frf.png)",
         "",
