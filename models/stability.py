@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from railopt.models.vehicle.model import VehicleModel, check_speed
 from railopt.models.vehicle.vehicle import Vehicle
@@ -141,8 +141,11 @@ def critical_speed(
     """Lowest forward speed in ``speed_range`` where a root crosses into Re s > 0.
 
     The spectral abscissa a(S) is evaluated on ``grid`` evenly spaced speeds until it changes
-    sign; the first bracket is refined by Brent's method to ``tol`` m/s.  (A crossing narrower
-    than the grid spacing can be missed; raise ``grid`` when in doubt.)
+    sign; the first bracket is refined by Brent's method to ``tol`` m/s (:func:`first_crossing`).
+    A sampled local maximum of a(S) below zero is searched for a hidden unstable window first.
+    What is promised: no crossing was found at the grid's resolution after that search; an unstable
+    window that neither changes the sign of a sample nor raises a sampled local maximum (narrower than
+    the grid spacing and between samples) can be missed — raise ``grid`` when in doubt.
 
     Parameters
     ----------
@@ -163,20 +166,45 @@ def critical_speed(
     if grid < 2:
         raise ValueError(f"grid: need at least 2 speeds, got {grid}")
     ab = _Abscissa(_model(vehicle, track))
-    speeds = np.linspace(lo, hi, grid)
-    prev_s, prev_a = speeds[0], ab(speeds[0])
-    if prev_a > 0.0:
+    found, bracket = first_crossing(ab, lo, hi, tol, grid)
+    if found == lo and bracket == (lo, lo):
         f, mode = _critical_root(ab, lo)
         return CriticalSpeed(lo, f, mode, ab.solves, (lo, lo), True, tol)
-    for S in speeds[1:]:
-        a = ab(S)
-        if a > 0.0:
-            root = brentq(ab, prev_s, S, xtol=tol, rtol=4.0 * np.finfo(float).eps)
-            upper = min(root + tol, S)
-            f, mode = _critical_root(ab, upper)
-            return CriticalSpeed(float(root), f, mode, ab.solves, (float(root - tol), float(upper)), False, tol)
-        prev_s, prev_a = S, a
-    return CriticalSpeed(math.inf, math.nan, "", ab.solves, (float(hi), math.inf), False, tol)
+    if math.isinf(found):
+        return CriticalSpeed(math.inf, math.nan, "", ab.solves, bracket, False, tol)
+    f, mode = _critical_root(ab, bracket[1])
+    return CriticalSpeed(found, f, mode, ab.solves, bracket, False, tol)
+
+
+def first_crossing(a, lo: float, hi: float, tol: float, grid: int) -> tuple[float, tuple[float, float]]:
+    """Lowest S in [lo, hi] where ``a(S)`` (the spectral abscissa) becomes positive.
+
+    ``a`` is sampled on ``grid`` even speeds; the first sign change is refined by Brent's method to
+    ``tol``.  Where the samples show an interior local maximum below zero (a root that approaches the
+    axis between samples and turns back), ``a`` is maximised there by bounded Brent search first, so an
+    unstable window that raises the sampled abscissa is not stepped over.  Returns ``(lo, (lo, lo))``
+    when ``a(lo) > 0``, ``(inf, (hi, inf))`` when no crossing is found.
+    """
+    speeds = np.linspace(lo, hi, grid)
+    values = [a(speeds[0])]
+    if values[0] > 0.0:
+        return lo, (lo, lo)
+    for i in range(1, grid):
+        values.append(a(speeds[i]))
+        if values[i] > 0.0:
+            return _refine(a, speeds[i - 1], speeds[i], tol)
+        # a sampled local maximum at i-1 (below zero): look between its neighbours for a hidden window
+        if i >= 2 and values[i - 1] >= values[i - 2] and values[i - 1] >= values[i]:
+            peak = minimize_scalar(lambda S: -a(S), bounds=(speeds[i - 2], speeds[i]), method="bounded",
+                                   options={"xatol": tol})
+            if -peak.fun > 0.0:
+                return _refine(a, speeds[i - 2], float(peak.x), tol)
+    return math.inf, (float(hi), math.inf)
+
+
+def _refine(a, left: float, right: float, tol: float) -> tuple[float, tuple[float, float]]:
+    root = brentq(a, left, right, xtol=tol, rtol=4.0 * np.finfo(float).eps)
+    return float(root), (float(max(root - tol, left)), float(min(root + tol, right)))
 
 
 def _critical_root(ab: _Abscissa, speed: float) -> tuple[float, str]:

@@ -161,8 +161,13 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame) -> Figure:
     """Fig 4.4 style: roots in the complex plane coloured by speed, one panel per model; and the
     least damping ratio against speed."""
     models = list(dict.fromkeys(locus["model"]))
-    fig = Figure(figsize=(5.2 * (len(models) + 1), 4.4))
-    axes = fig.subplots(1, len(models) + 1, squeeze=False)[0]
+    ncols = min(3, len(models) + 1)
+    nrows = -(-(len(models) + 1) // ncols)
+    fig = Figure(figsize=(5.4 * ncols, 4.2 * nrows))
+    axes = list(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    for extra in axes[len(models) + 1:]:
+        extra.set_visible(False)
+    axes = axes[: len(models) + 1]
     for ax, m in zip(axes, models, strict=False):
         d = locus[(locus["model"] == m) & (locus["frequency_hz"] < 25)]
         sc = ax.scatter(d["real"], d["frequency_hz"], c=d["speed"], s=3, cmap="viridis")
@@ -185,4 +190,44 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame) -> Figure:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------- forced response
+TRACK_STYLES = {"rigid": ("C0", "-", 1.4), "flexible": ("C3", "--", 1.4)}
+
+
+def plot_forced_response(series: dict[str, pd.DataFrame], title: str, note: str = "") -> Figure:
+    """Figs 4.5–4.12 style: amplitude (top) and phase (bottom) of one output against the forcing frequency,
+    rigid and flexible track on the same axes.
+
+    Parameters
+    ----------
+    series : mapping track -> DataFrame
+        Columns ``frequency_hz``, ``amplitude``, ``phase_deg``, ``unit``, ``output`` (one output).
+    title : str
+        Figure title (thesis figure label and name).
+    note : str
+        Caption (model, speed, irregularity).
+    """
+    fig = Figure(figsize=(7.0, 5.2))
+    ax, axp = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]})
+    unit = output = ""
+    for track, d in series.items():
+        color, ls, lw = TRACK_STYLES.get(track, ("k", "-", 1.2))
+        f = d["frequency_hz"].to_numpy()
+        i = int(np.argmax(d["amplitude"].to_numpy()))
+        ax.plot(f, d["amplitude"], color=color, ls=ls, lw=lw,
+                label=f"{track} track (max {d['amplitude'].iloc[i]:.4g} at {f[i]:.3g} Hz)")
+        axp.plot(f, d["phase_deg"], color=color, ls="none", marker=".", ms=1.5)
+        unit, output = d["unit"].iloc[0], d["output"].iloc[0]
+    ax.set_ylabel(f"|{output}| ({unit})")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    axp.set_ylabel("phase (deg)")
+    axp.set_yticks([-180, -90, 0, 90, 180])
+    axp.set_xlabel("forcing frequency f = S/L (Hz)")
+    axp.grid(alpha=0.3)
+    _caption(fig, note)
     return fig

@@ -101,3 +101,25 @@ def test_neutral_rigid_body_roots_are_not_instability(sd40, track: str) -> None:
         s = m.eigenvalues()
         assert np.sum(np.abs(s) < 1e-6) >= 6
         assert spectral_abscissa(m) < 0.0
+
+
+def test_hidden_unstable_window_between_samples_is_found():
+    """a(S) = −0.1 + 0.3 exp(−((S − 50)/4)²): every sample of an 8-point grid on [1, 100] is negative, but
+    the window raises a sampled local maximum; its first crossing is S = 50 − 4 √ln 3 exactly."""
+    from railopt.models.stability import first_crossing
+
+    def a(S):
+        return -0.1 + 0.3 * np.exp(-(((S - 50.0) / 4.0) ** 2))
+
+    grid = np.linspace(1.0, 100.0, 8)
+    assert np.all(a(grid) < 0)
+    speed, bracket = first_crossing(a, 1.0, 100.0, 1e-6, 8)
+    assert speed == pytest.approx(50.0 - 4.0 * np.sqrt(np.log(3.0)), abs=1e-6)
+    assert bracket[0] <= speed <= bracket[1]
+
+
+def test_monotone_stable_abscissa_reports_no_crossing():
+    from railopt.models.stability import first_crossing
+
+    speed, bracket = first_crossing(lambda S: -1.0 / S, 1.0, 100.0, 0.01, 8)
+    assert speed == float("inf") and bracket == (100.0, float("inf"))

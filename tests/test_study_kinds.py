@@ -164,3 +164,29 @@ def test_no_model_module_imports_matplotlib_or_design():
             for name in names:
                 assert not name.startswith("matplotlib"), path
                 assert not name.startswith("railopt.design"), path
+
+
+@pytest.mark.slow
+def test_locomotive_stability_study_matches_the_model_layer(tmp_path):
+    """The bundled stability study: its critical speeds equal direct calls, sensitivities move the way the
+    physics says, and flexible track tends to rigid track as the track modulus grows."""
+    from railopt.models.stability import critical_speed
+    from railopt.models.vehicle import load_vehicle
+
+    assert main(["run", str(STUDIES_DIR / "locomotive_stability.toml"), "--results", str(tmp_path),
+                 "--no-progress"]) == 0
+    out = tmp_path / "locomotive_stability"
+    crit = pd.read_csv(out / "critical_speeds.csv").set_index("model")
+    for label, vehicle, track in (("sd40-2_rigid", "sd40-2", "rigid"), ("coach_flexible", "manchester-coach",
+                                                                          "flexible")):
+        direct = critical_speed(load_vehicle(vehicle), track, (1.0, 150.0), tol=1e-6, grid=16)
+        assert crit.loc[label, "critical_speed_m_s"] == pytest.approx(direct.speed, abs=0.01)
+    sens = pd.read_csv(out / "sensitivity.csv")
+    loco = sens[(sens.model == "sd40-2_flexible") & (sens.parameter == "track_modulus")].sort_values("factor")
+    gaps = np.abs(loco["critical_speed_m_s"].to_numpy() - crit.loc["sd40-2_rigid", "critical_speed_m_s"])
+    assert np.all(np.diff(gaps) < 0) and gaps[-1] < 0.1  # → rigid as the modulus grows
+    rigid = sens[(sens.model == "sd40-2_rigid") & (sens.parameter == "conicity")].sort_values("factor")
+    assert np.all(np.diff(rigid["critical_speed_m_s"]) < 0)  # more conicity, lower critical speed
+    effect = pd.read_csv(out / "track_effect.csv").set_index("flexible")
+    assert effect.loc["sd40-2_flexible", "change_m_s"] == pytest.approx(
+        crit.loc["sd40-2_flexible", "critical_speed_m_s"] - crit.loc["sd40-2_rigid", "critical_speed_m_s"], abs=1e-12)

@@ -142,10 +142,55 @@ def run(config: SpeedSweepConfig, context: StudyContext) -> StudyOutcome:
              f"Root locus over {cfg.speeds.range_m_s[0]:g}–{cfg.speeds.range_m_s[1]:g} m/s; critical speed searched "
              f"in {cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s to ±{cfg.critical.tol_m_s:g} m/s.",
              "", markdown_table(critical_table), ""]
+    track_effect = _track_effect(cfg, critical_table)
+    if len(track_effect):
+        lines += ["Flexible against rigid track (same vehicle and parameters):", "", markdown_table(track_effect), ""]
+        lines += _track_effect_sentences(track_effect, sens_table)
+        files += write_table(track_effect, context.outdir, "track_effect")
     if len(sens_table):
-        lines += ["Sensitivity of the critical speed:", "", markdown_table(sens_table.drop(columns=["tol_m_s"])), ""]
+        pivot = sens_table.pivot_table(index=["parameter", "factor"], columns="model", values="critical_speed_m_s",
+                                       sort=False).reset_index()
+        lines += ["Critical speed (m/s) with one parameter scaled by `factor` (all columns in `sensitivity.csv`):",
+                  "", markdown_table(pivot, digits=5), ""]
     lines += ["![root locus](root_locus.png)", ""]
     return StudyOutcome(table=critical_table, markdown="\n".join(lines), files=files)
+
+
+def _track_effect_sentences(effect: pd.DataFrame, sens: pd.DataFrame) -> list[str]:
+    """The rigid/flexible finding in words, with the track-modulus limit when it was swept."""
+    lines = []
+    for _, r in effect.iterrows():
+        verb = "raises" if r["change_m_s"] > 0 else "lowers"
+        text = (f"- `{r['flexible']}`: the flexible track {verb} the critical speed by "
+                f"{abs(r['change_percent']):.2f} % ({abs(r['change_m_s']):.3f} m/s) against `{r['rigid']}`.")
+        if len(sens) and "track_modulus" in set(sens["parameter"]):
+            rows = sens[(sens["parameter"] == "track_modulus") & (sens["model"] == r["flexible"])]
+            steps = ", ".join(f"×{f:g}: {100 * (v / r['rigid_m_s'] - 1):+.2f} %"
+                              for f, v in zip(rows["factor"], rows["critical_speed_m_s"], strict=True))
+            text += f" Against the rigid value with the track modulus scaled: {steps} (→ rigid as the modulus grows)."
+        lines.append(text)
+    return lines + [""]
+
+
+def _track_effect(cfg: SpeedSweepConfig, critical: pd.DataFrame) -> pd.DataFrame:
+    """Pairs of models that differ only in ``track``: the change of critical speed, flexible − rigid."""
+    by_key: dict[str, dict[str, str]] = {}
+    for ref in cfg.models:
+        opts = dict(ref.options)
+        track = opts.pop("track", "rigid")
+        key = f"{ref.model}:{sorted(opts.items())}"
+        by_key.setdefault(key, {})[track] = ref.label
+    crit = critical.set_index("model")
+    rows = []
+    for pair in by_key.values():
+        if {"rigid", "flexible"} <= set(pair):
+            r, f = crit.loc[pair["rigid"]], crit.loc[pair["flexible"]]
+            rows.append({"rigid": pair["rigid"], "flexible": pair["flexible"],
+                         "rigid_m_s": r["critical_speed_m_s"], "flexible_m_s": f["critical_speed_m_s"],
+                         "change_m_s": f["critical_speed_m_s"] - r["critical_speed_m_s"],
+                         "change_percent": 100 * (f["critical_speed_m_s"] / r["critical_speed_m_s"] - 1),
+                         "rigid_hz": r["hunting_frequency_hz"], "flexible_hz": f["hunting_frequency_hz"]})
+    return pd.DataFrame(rows)
 
 
 KIND = register_kind(StudyKind(
