@@ -26,8 +26,10 @@ from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV
 from railopt.studies.base import StudyContext
 from railopt.studies.config import ConfigError, load_study
 from railopt.studies.publish import (
+    CAMPAIGNS,
     ResultsError,
     carry_stores,
+    check_writable,
     clear_leftovers,
     ensure_folder,
     publish,
@@ -97,6 +99,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     final = results / name
     if final.exists() and not final.is_dir():
         raise ResultsError(f"results: {final} is a file, not a folder; move it away to publish study {name!r}")
+    check_writable(results, final, final / CAMPAIGNS)  # before hours of work, not when publishing
     timeout = None if args.scheduler_timeout is None else str(args.scheduler_timeout)
     with study_lock(results, name), _environ(SCHEDULER_TIMEOUT_ENV, timeout):
         clear_leftovers(results, name)

@@ -61,6 +61,13 @@ def ensure_folder(path: Path) -> Path:
     return path
 
 
+def check_writable(*folders: Path) -> None:
+    """Refuse early, naming it, a folder among ``folders`` that exists but cannot be written."""
+    for folder in folders:
+        if folder.is_dir() and not os.access(folder, os.W_OK | os.X_OK):
+            raise ResultsError(f"results: {folder} is not writable; make it writable or choose another --results")
+
+
 def lock_path(results: Path, study: str) -> Path:
     return results / f".{study}.lock"
 
