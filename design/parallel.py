@@ -95,13 +95,14 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
 
     if scheduler is not None:
         wait = scheduler_timeout(timeout)
+        hint = f"check the address (--scheduler or ${SCHEDULER_ENV}), or run on a local cluster with --workers N"
         try:
             client = Client(scheduler, timeout=wait)
-        except (OSError, ValueError, TypeError) as exc:
-            raise SchedulerError(
-                f"scheduler: cannot connect to {scheduler!r} within {wait:g} s ({exc}); check the address "
-                f"(--scheduler or ${SCHEDULER_ENV}), or run on a local cluster with --workers N"
-            ) from None
+        except (ValueError, TypeError) as exc:
+            raise SchedulerError(f"scheduler: {scheduler!r} is not a valid address ({exc}); {hint}") from None
+        except OSError as exc:
+            raise SchedulerError(f"scheduler: cannot connect to {scheduler!r} within {wait:g} s ({exc}); {hint}"
+                                 ) from None
         with client:
             yield client
         return
