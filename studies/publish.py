@@ -27,7 +27,7 @@ import shutil
 import socket
 import sys
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 CAMPAIGNS = "campaigns"
@@ -43,7 +43,7 @@ class StudyLocked(ResultsError):
 
 def _os_error(exc: OSError, path: Path, doing: str) -> ResultsError:
     where = exc.filename if exc.filename is not None else path
-    if exc.errno in (errno.ENOTDIR, errno.EEXIST) or isinstance(exc, NotADirectoryError | FileExistsError):
+    if exc.errno in (errno.ENOTDIR, errno.EEXIST):
         why = "a file is in the way where a folder must be"
     else:
         why = exc.strerror or str(exc)
@@ -131,7 +131,8 @@ def study_lock(results: Path, study: str) -> Iterator[Path]:
         os.write(fd, f"{os.getpid()} {socket.gethostname()} {now}\n".encode())
         yield path
     finally:
-        path.unlink(missing_ok=True)  # while still holding it: see the samestat check above
+        with suppress(OSError):  # a folder made read-only meanwhile must not hide the run's own error
+            path.unlink(missing_ok=True)  # while still holding it: see the samestat check above
         os.close(fd)
 
 
@@ -161,10 +162,9 @@ def clear_leftovers(results: Path, study: str) -> list[Path]:
     if olds and not final.exists():
         os.rename(olds.pop(), final)  # the newest: the folder that was published last
         touched.append(final)
-    for path in _leftovers(results, study, "staging") + olds:
-        if path != staging_path(results, study):
-            shutil.rmtree(path, ignore_errors=True)
-            touched.append(path)
+    for path in _leftovers(results, study, "staging") + olds:  # ours too: a dead run may have had our PID
+        shutil.rmtree(path, ignore_errors=True)
+        touched.append(path)
     return touched
 
 
