@@ -162,7 +162,7 @@ def test_two_processes_creating_one_store_one_wins_and_its_file_survives(tmp_pat
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"c{t}.sqlite" for t in range(20))  # no temp files
 
 
-def test_store_write_failures_name_the_file(tmp_path):
+def test_store_open_refusals_name_the_file(tmp_path):
     path = tmp_path / "c.sqlite"
     CampaignStore.create(path, "c", {}, ["x"]).close()
     with pytest.raises(StoreError, match=f"^store: {path}.*different config.*--fresh"):
