@@ -9,6 +9,8 @@ dask run of the same campaign would not give the same table.
 
 from __future__ import annotations
 
+import math
+import numbers
 import os
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
@@ -62,16 +64,19 @@ class SchedulerError(ConnectionError):
     """The dask scheduler cannot be reached (or its address is not valid); the message names it."""
 
 
-def scheduler_timeout(timeout: float | None = None) -> float:
-    """Seconds to wait for a scheduler: ``timeout``, else ``$RAILOPT_SCHEDULER_TIMEOUT``, else 5."""
+def scheduler_timeout(timeout: float | None = None, field: str = "timeout") -> float:
+    """Seconds to wait for a scheduler: ``timeout``, else ``$RAILOPT_SCHEDULER_TIMEOUT``, else 5.
+
+    A value that is not a positive finite number raises ``ValueError`` naming ``field`` (or the variable).
+    """
     if timeout is None:
         text = os.environ.get(SCHEDULER_TIMEOUT_ENV, "").strip()
         try:
-            timeout = float(text) if text else DEFAULT_SCHEDULER_TIMEOUT
+            timeout, field = (float(text), SCHEDULER_TIMEOUT_ENV) if text else (DEFAULT_SCHEDULER_TIMEOUT, field)
         except ValueError:
             raise ValueError(f"{SCHEDULER_TIMEOUT_ENV}: must be a number of seconds, got {text!r}") from None
-    if not (isinstance(timeout, int | float) and not isinstance(timeout, bool) and 0 < timeout < float("inf")):
-        raise ValueError(f"scheduler timeout: must be a positive number of seconds, got {timeout!r}")
+    if not (isinstance(timeout, numbers.Real) and not isinstance(timeout, bool) and 0 < timeout < math.inf):
+        raise ValueError(f"{field}: must be a positive number of seconds, got {timeout!r}")
     return float(timeout)
 
 

@@ -22,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from railopt import __version__
-from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV
+from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV, scheduler_timeout
 from railopt.studies.base import StudyContext
 from railopt.studies.config import ConfigError, load_study
 from railopt.studies.publish import (
@@ -61,8 +61,8 @@ def _check_flags(args: argparse.Namespace) -> None:
         raise ConfigError(f"--workers: must be ≥ 0, got {args.workers}")
     if args.workers is not None and args.scheduler:
         raise ConfigError("--workers and --scheduler: give one of them (a local cluster or an existing scheduler)")
-    if args.scheduler_timeout is not None and not 0 < args.scheduler_timeout < float("inf"):
-        raise ConfigError(f"--scheduler-timeout: must be a positive number of seconds, got {args.scheduler_timeout}")
+    if args.scheduler_timeout is not None:
+        scheduler_timeout(args.scheduler_timeout, "--scheduler-timeout")
 
 
 @contextmanager
