@@ -52,10 +52,14 @@ class DuplicateStart(StoreError, sqlite3.IntegrityError):
     """A start (or row) that is already in the store; still an ``sqlite3.IntegrityError``."""
 
 
+# SQLite result codes that say nothing about the file's contents: busy, read-only, disk full, ...
+_NOT_DAMAGE = ("SQLITE_BUSY", "SQLITE_LOCKED", "SQLITE_CANTOPEN", "SQLITE_READONLY", "SQLITE_IOERR", "SQLITE_FULL",
+               "SQLITE_PERM", "SQLITE_NOMEM", "SQLITE_INTERRUPT")
+
+
 def _sqlite_error(path: Path, exc: sqlite3.Error, doing: str) -> StoreError:
-    """A store error naming the file: damage (corrupt, not a database) or another failure (locked, read-only)."""
-    name = getattr(exc, "sqlite_errorname", "")
-    if isinstance(exc, sqlite3.OperationalError) and not name.startswith(("SQLITE_CORRUPT", "SQLITE_NOTADB")):
+    """A store error naming the file: :class:`StoreDamaged`, unless the failure is not the file's contents."""
+    if getattr(exc, "sqlite_errorname", "").startswith(_NOT_DAMAGE):
         return StoreError(f"store: cannot {doing} {path} ({exc})")
     return StoreDamaged(path, str(exc))
 
@@ -139,11 +143,12 @@ def _initialise(db: sqlite3.Connection, name: str, config: Mapping[str, Any], va
 
 def _link_exclusive(src: Path, dst: Path) -> None:
     """Give ``src`` the name ``dst`` unless ``dst`` exists (``FileExistsError``); never replaces."""
+    taken = f"store: {dst} already exists (another process created it first)"
     try:
         os.link(src, dst)
         return
     except FileExistsError:
-        raise FileExistsError(f"store: {dst} already exists (another process created it first)") from None
+        raise FileExistsError(taken) from None
     except OSError as exc:
         if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK):
             raise
@@ -151,9 +156,29 @@ def _link_exclusive(src: Path, dst: Path) -> None:
     try:
         fd = os.open(dst, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
     except FileExistsError:
-        raise FileExistsError(f"store: {dst} already exists (another process created it first)") from None
+        raise FileExistsError(taken) from None
     with os.fdopen(fd, "wb") as out, open(src, "rb") as inp:
         out.write(inp.read())
+
+
+def _check_store(path: Path, db: sqlite3.Connection, expect_config: Mapping[str, Any] | None) -> None:
+    """Refuse a store that is damaged, of another schema version or (``expect_config``) of another config."""
+    problems = [r[0] for r in db.execute("PRAGMA integrity_check").fetchall()]  # quick_check misses index damage
+    if problems != ["ok"]:
+        raise StoreDamaged(path, f"integrity check: {problems[0].splitlines()[-1]}")
+    tables = {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    missing = [t for t in TABLES if t not in tables]
+    if missing:
+        raise StoreDamaged(path, f"no campaign tables {missing}")
+    version = dict(db.execute("SELECT key, value FROM meta").fetchall()).get("schema_version")
+    campaigns = db.execute("SELECT config_hash FROM campaign").fetchall()
+    if version is None or len(campaigns) != 1:
+        raise StoreDamaged(path, "no schema version or campaign record")
+    if version != str(SCHEMA_VERSION):
+        raise StoreError(f"store: schema version {version} in {path}, this railopt reads {SCHEMA_VERSION}")
+    if expect_config is not None and campaigns[0][0] != config_hash(expect_config):
+        raise StoreError(f"store: {path} was made from a different config; refusing to resume it "
+                         "(run again with --fresh to discard it)")
 
 
 class CampaignStore:
@@ -172,9 +197,8 @@ class CampaignStore:
             raise FileExistsError(f"store: {path} already exists (resume it, or remove it to start afresh)")
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-        except (FileExistsError, NotADirectoryError) as exc:
-            raise StoreError(f"store: cannot create the folder {path.parent}: a file is in the way ({exc.filename})"
-                             ) from None
+        except (FileExistsError, NotADirectoryError):
+            raise StoreError(f"store: cannot create the folder {path.parent}: a file is in the way") from None
         # initialise under a name only this call uses, then link it into place: the link fails if
         # another process got there first, and only our own temporary file is ever removed
         tmp = path.with_name(f".{path.name}.creating-{os.getpid()}-{uuid.uuid4().hex[:8]}")
@@ -215,34 +239,18 @@ class CampaignStore:
             raise StoreDamaged(path, "empty file")
         if header != _HEADER:
             raise StoreDamaged(path, "not an SQLite database: bad header")
-        db = None
         try:
             db = sqlite3.connect(f"{path.resolve().as_uri()}?mode=rw", uri=True)
-            problems = [r[0] for r in db.execute("PRAGMA integrity_check").fetchall()]
-            if problems != ["ok"]:
-                raise StoreDamaged(path, f"integrity check: {problems[0].splitlines()[-1]}")
-            tables = {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-            missing = [t for t in TABLES if t not in tables]
-            if missing:
-                raise StoreDamaged(path, f"no campaign tables {missing}")
-            store = cls(path, db)
-            version = store.meta().get("schema_version")
-            if version is None or store._db.execute("SELECT COUNT(*) FROM campaign").fetchone()[0] != 1:
-                raise StoreDamaged(path, "no schema version or campaign record")
-            if version != str(SCHEMA_VERSION):
-                raise StoreError(f"store: schema version {version} in {path}, this railopt reads {SCHEMA_VERSION}")
-            if expect_config is not None and store.config_hash != config_hash(expect_config):
-                raise StoreError(f"store: {path} was made from a different config; refusing to resume it "
-                                 "(run again with --fresh to discard it)")
         except sqlite3.Error as exc:
-            if db is not None:
-                db.close()
-            raise _sqlite_error(path, exc, "read") from None
-        except BaseException:
-            if db is not None:
-                db.close()
+            raise _sqlite_error(path, exc, "open") from None
+        try:
+            _check_store(path, db, expect_config)
+        except BaseException as exc:
+            db.close()
+            if isinstance(exc, sqlite3.Error):
+                raise _sqlite_error(path, exc, "read") from None
             raise
-        return store
+        return cls(path, db)
 
     def close(self) -> None:
         self._db.close()

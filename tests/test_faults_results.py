@@ -14,8 +14,6 @@ import signal
 import socket
 import subprocess
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
@@ -27,6 +25,7 @@ from faults_cli import (
     count_starts,
     dead_pid,
     env,
+    read_only,
     run_args,
     snapshot,
     start,
@@ -100,30 +99,12 @@ def test_study_folder_that_is_a_file_is_named(published, tmp_path):
     assert sorted(p.name for p in root.iterdir()) == [STUDY]  # no staging, no lock left
 
 
-@contextmanager
-def _read_only(folder: Path) -> Iterator[None]:
-    """``folder`` unwritable: by its mode for a user, by the immutable attribute for root (whom modes do not stop)."""
-    if os.geteuid() != 0:
-        folder.chmod(0o555)
-        try:
-            yield
-        finally:
-            folder.chmod(0o755)
-        return
-    if subprocess.run(["chattr", "+i", str(folder)], capture_output=True).returncode != 0:
-        pytest.skip("root, and no immutable attribute on this file system (the file-in-the-way tests cover root)")
-    try:
-        yield
-    finally:
-        subprocess.run(["chattr", "-i", str(folder)], check=True)
-
-
 @pytest.mark.parametrize("where", ["", STUDY, f"{STUDY}/campaigns"])
 def test_read_only_folders_are_named_and_the_previous_results_kept(where, published, results):
     study, _ = published
     folder = results / where
     before, rows = _published_files(results), start_rows(store_path(results))
-    with _read_only(folder):
+    with read_only(folder):
         done = cli(*run_args(study, results, "--resume"))
     assert_refused(done, folder)
     assert _published_files(results) == before

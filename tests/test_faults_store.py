@@ -15,7 +15,7 @@ import sqlite3
 from pathlib import Path
 
 import pytest
-from faults_cli import STUDY, assert_refused, cli, run_args, snapshot, start_rows, store_path, study_file
+from faults_cli import STUDY, assert_refused, cli, read_only, run_args, snapshot, start_rows, store_path, study_file
 
 from railopt.design.store import CampaignStore, StoreDamaged, StoreError
 
@@ -120,6 +120,17 @@ def test_fresh_replaces_a_damaged_store(damage, published, results):
     with CampaignStore.open(store_path(results)) as store:  # intact again, every start once
         assert sorted(store.finished_ids()) == list(range(N_STARTS + 1))
     assert [r[0] for r in start_rows(store_path(results))] == [r[0] for r in reference]
+
+
+def test_a_read_only_store_is_named_and_kept(published, results):
+    study, _ = published
+    store = store_path(results)
+    before = snapshot(results)
+    with read_only(store):
+        done = cli(*run_args(study, results, "--resume"))
+    assert_refused(done, f"cannot write check 'spectral_abscissa' of start 1 to {store}", "readonly database")
+    assert snapshot(results) == before
+    assert sorted(p.name for p in results.iterdir()) == [STUDY]
 
 
 def test_a_file_where_the_campaigns_folder_must_be_is_named(published, tmp_path):
