@@ -39,6 +39,14 @@ def study_file(folder: Path, n_starts: int) -> Path:
     return path
 
 
+def publish_baseline(folder: Path, n_starts: int) -> tuple[Path, Path]:
+    """(study file, results root) of one successful run into ``folder``: the previous results of a test."""
+    study = study_file(folder, n_starts)
+    done = cli(*run_args(study, folder / "results"))
+    assert done.returncode == 0, done.stderr
+    return study, folder / "results"
+
+
 def env(**extra: str) -> dict[str, str]:
     base = {k: v for k, v in os.environ.items() if not k.startswith("RAILOPT_")}
     return {**base, "PYTHONUNBUFFERED": "1", **extra}

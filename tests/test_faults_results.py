@@ -12,6 +12,7 @@ import os
 import shutil
 import signal
 import socket
+import sqlite3
 import subprocess
 import sys
 from pathlib import Path
@@ -25,6 +26,7 @@ from faults_cli import (
     count_starts,
     dead_pid,
     env,
+    publish_baseline,
     read_only,
     run_args,
     snapshot,
@@ -45,11 +47,7 @@ IDS = list(range(N_STARTS + 1))
 @pytest.fixture(scope="module")
 def published(tmp_path_factory) -> tuple[Path, Path]:
     """(study file, results root) of one successful run: the previous results every test starts from."""
-    folder = tmp_path_factory.mktemp("published")
-    study = study_file(folder, N_STARTS)
-    done = cli(*run_args(study, folder / "results"))
-    assert done.returncode == 0, done.stderr
-    return study, folder / "results"
+    return publish_baseline(tmp_path_factory.mktemp("published"), N_STARTS)
 
 
 @pytest.fixture
@@ -69,8 +67,6 @@ def _leftovers(results: Path) -> list[str]:
 
 def _forget_starts_from(store: Path, first: int) -> None:
     """Make the store look like a campaign killed after ``first`` starts."""
-    import sqlite3
-
     with sqlite3.connect(store) as db:
         db.execute("DELETE FROM starts WHERE start_id >= ?", (first,))
         db.execute("DELETE FROM checks")

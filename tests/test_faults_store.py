@@ -15,7 +15,17 @@ import sqlite3
 from pathlib import Path
 
 import pytest
-from faults_cli import STUDY, assert_refused, cli, read_only, run_args, snapshot, start_rows, store_path, study_file
+from faults_cli import (
+    STUDY,
+    assert_refused,
+    cli,
+    publish_baseline,
+    read_only,
+    run_args,
+    snapshot,
+    start_rows,
+    store_path,
+)
 
 from railopt.design.store import CampaignStore, StoreDamaged, StoreError
 
@@ -25,11 +35,7 @@ N_STARTS = 3  # + the Den Hartog start: ids 0..3
 @pytest.fixture(scope="module")
 def published(tmp_path_factory) -> tuple[Path, Path]:
     """(study file, results root) of one successful run: the previous results every test starts from."""
-    folder = tmp_path_factory.mktemp("published")
-    study = study_file(folder, N_STARTS)
-    done = cli(*run_args(study, folder / "results"))
-    assert done.returncode == 0, done.stderr
-    return study, folder / "results"
+    return publish_baseline(tmp_path_factory.mktemp("published"), N_STARTS)
 
 
 @pytest.fixture
