@@ -161,6 +161,19 @@ def _kill_when(proc: subprocess.Popen, condition, sig: int = signal.SIGKILL) -> 
     proc.wait(30)
 
 
+def _interrupt_a_resumed_campaign(study: Path, results: Path, sig: int, at: int):
+    """Resume a campaign that stopped after 4 starts; send ``sig`` once ``at`` starts are stored.
+
+    Returns the process and the published files (stores aside) as they were before.
+    """
+    store = store_path(results)
+    _forget_starts_from(store, 4)
+    published_before = _published_files(results)
+    proc = start(*run_args(study, results, "--resume"))
+    _kill_when(proc, lambda: count_starts(store) >= at, sig=sig)
+    return proc, published_before
+
+
 @pytest.mark.slow
 def test_kill_during_a_fresh_campaign_keeps_the_previous_results_and_stores(published, results):
     study, _ = published
@@ -182,10 +195,7 @@ def test_kill_during_a_fresh_campaign_keeps_the_previous_results_and_stores(publ
 def test_kill_during_a_resumed_campaign_keeps_every_finished_start_once(published, results):
     study, _ = published
     store = store_path(results)
-    _forget_starts_from(store, 4)
-    published_before = _published_files(results)
-    proc = start(*run_args(study, results, "--resume"))
-    _kill_when(proc, lambda: count_starts(store) >= 8)
+    proc, published_before = _interrupt_a_resumed_campaign(study, results, signal.SIGKILL, at=8)
     kept = start_rows(store)
     assert 8 <= len(kept) < len(IDS)
     assert _published_files(results) == published_before  # nothing published by the killed run
@@ -240,10 +250,7 @@ def test_a_run_killed_between_the_swap_renames_is_rolled_back(published, results
 def test_sigterm_during_a_campaign_cleans_up_and_keeps_finished_starts(published, results):
     study, _ = published
     store = store_path(results)
-    _forget_starts_from(store, 4)
-    published_before = _published_files(results)
-    proc = start(*run_args(study, results, "--resume"))
-    _kill_when(proc, lambda: count_starts(store) >= 6, sig=signal.SIGTERM)
+    proc, published_before = _interrupt_a_resumed_campaign(study, results, signal.SIGTERM, at=6)
     err = proc.stderr.read()
     assert proc.returncode == 143, err
     assert "Traceback" not in err and "rerun with --resume" in err
