@@ -136,12 +136,9 @@ def study_lock(results: Path, study: str) -> Iterator[Path]:
         os.close(fd)
 
 
-def staging_path(results: Path, study: str, pid: int | None = None) -> Path:
-    return results / f".staging-{study}-{os.getpid() if pid is None else pid}"
-
-
-def _old_path(results: Path, study: str, pid: int | None = None) -> Path:
-    return results / f".old-{study}-{os.getpid() if pid is None else pid}"
+def staging_path(results: Path, study: str) -> Path:
+    """This run's staging folder for ``study``."""
+    return results / f".staging-{study}-{os.getpid()}"
 
 
 def _leftovers(results: Path, study: str, kind: str) -> list[Path]:
@@ -149,23 +146,21 @@ def _leftovers(results: Path, study: str, kind: str) -> list[Path]:
     return sorted((p for p in results.iterdir() if pattern.match(p.name)), key=lambda p: p.stat().st_mtime)
 
 
-def clear_leftovers(results: Path, study: str) -> list[Path]:
-    """Remove what dead runs of ``study`` left behind; call it holding the study lock.
+def clear_leftovers(results: Path, study: str) -> None:
+    """Remove what dead runs of ``study`` left behind (with a note on stderr); call it holding the study lock.
 
     Holding the lock means no other run of the study is alive, so every staging folder of the
     study is stale.  A run killed between the two renames of :func:`publish` leaves no published
-    folder but an ``.old-`` one: that one is put back.  Returns the paths removed or restored.
+    folder but an ``.old-`` one: that one is put back.
     """
     final = results / study
-    touched = []
     olds = _leftovers(results, study, "old")
     if olds and not final.exists():
         os.rename(olds.pop(), final)  # the newest: the folder that was published last
-        touched.append(final)
+        print(f"railopt: note: put back {final}, moved aside by a run killed while publishing", file=sys.stderr)
     for path in _leftovers(results, study, "staging") + olds:  # ours too: a dead run may have had our PID
         shutil.rmtree(path, ignore_errors=True)
-        touched.append(path)
-    return touched
+        print(f"railopt: note: removed {path}, left by a run that did not finish", file=sys.stderr)
 
 
 def carry_stores(final: Path, staging: Path) -> None:
@@ -182,7 +177,7 @@ def carry_stores(final: Path, staging: Path) -> None:
 
 def publish(staging: Path, final: Path) -> None:
     """Make ``staging`` the published ``final`` folder with renames; the old one survives any failure."""
-    old = _old_path(final.parent, final.name)
+    old = final.parent / f".old-{final.name}-{os.getpid()}"
     had_final = final.exists()
     if had_final:
         os.rename(final, old)

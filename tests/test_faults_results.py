@@ -187,6 +187,7 @@ def test_kill_during_a_fresh_campaign_keeps_the_previous_results_and_stores(publ
     done = cli(*run_args(study, results, "--resume"))
     assert done.returncode == 0, done.stderr
     assert _leftovers(results) == []  # ... is gone after the next run
+    assert f"removed {results / f'.staging-{STUDY}-{proc.pid}'}, left by a run that did not finish" in done.stderr
     assert f"PID {proc.pid}" in done.stderr and "stale lock" in done.stderr
     assert start_rows(store_path(results)) == start_rows(store_path(published[1]))  # old starts, not rerun
 
@@ -243,6 +244,7 @@ def test_a_run_killed_between_the_swap_renames_is_rolled_back(published, results
     done = cli(*run_args(study, results, "--resume"))
     assert done.returncode == 0, done.stderr
     assert start_rows(store_path(results)) == start_rows(store_path(published[1]))  # the old stores came back
+    assert f"put back {results / STUDY}" in done.stderr
     assert _leftovers(results) == []
 
 
