@@ -106,9 +106,9 @@ class MinimaxProblem:
             v = fun(x)
             dv = jac(x) if want_grad and callable(jac) else None
         v = self._as_vector(v, field)
-        if want_grad and dv is None:
-            dv = self._fd(lambda y: self._as_vector(fun(y)[0] if jac is True else fun(y), field), x)
-        if dv is not None:
+        if want_grad and dv is None:  # finite differences: a wrong shape is the function's, not a Jacobian's
+            dv = self._fd(lambda y: self._as_vector(fun(y)[0] if jac is True else fun(y), field), x, field, len(v))
+        elif dv is not None:
             dv = self._as_jacobian(dv, len(v), jac_field)
         return v, dv
 
@@ -147,18 +147,30 @@ class MinimaxProblem:
         return float(max(0.0, np.max(np.where(np.isfinite(excess), excess, np.inf))))
 
     # ------------------------------------------------------------------ derivatives
-    def _fd(self, fun: VectorFunction, x: np.ndarray) -> np.ndarray:
-        """Central differences, steps of fd_step × range, one-sided at the bounds."""
+    def _fd(self, fun: VectorFunction, x: np.ndarray, field: str = "functions", m: int | None = None) -> np.ndarray:
+        """Central differences, steps of fd_step × range, one-sided at the bounds.
+
+        ``m`` is the number of values ``fun`` returned at x; every step must return as many
+        (a ``ValueError`` naming ``field`` otherwise).
+        """
         sp = self.space
-        f0 = fun(x)
-        J = np.zeros((len(f0), sp.dim))
+        m = len(fun(x)) if m is None else m
+
+        def at(y: np.ndarray) -> np.ndarray:
+            v = fun(y)
+            if len(v) != m:
+                raise ValueError(f"{field}: returned {len(v)} values at a finite-difference step, {m} at x; "
+                                 "the count must be fixed")
+            return v
+
+        J = np.zeros((m, sp.dim))
         for i in range(sp.dim):
             h = self.fd_step * (sp.upper[i] - sp.lower[i])
             xp, xm = x.copy(), x.copy()
             xp[i] = min(x[i] + h, sp.upper[i])
             xm[i] = max(x[i] - h, sp.lower[i])
             with np.errstate(invalid="ignore"):
-                J[:, i] = (fun(xp) - fun(xm)) / (xp[i] - xm[i])
+                J[:, i] = (at(xp) - at(xm)) / (xp[i] - xm[i])
         J[~np.isfinite(J)] = 0.0  # a difference across an unbounded (inf) response carries no slope
         return J
 

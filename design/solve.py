@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import numbers
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -25,10 +27,14 @@ def method_options(method: str, options: dict[str, Any] | None = None) -> dict[s
             raise ValueError(f"options.{key}: unknown option for method {method!r}; known: {sorted(merged)}")
         merged[key] = value
     for key in ("xtol", "ftol", "maxtime"):
-        if not (isinstance(merged[key], int | float) and merged[key] > 0):
-            raise ValueError(f"options.{key}: must be a positive number, got {merged[key]!r}")
-    if not (isinstance(merged["maxeval"], int) and merged["maxeval"] > 0):
-        raise ValueError(f"options.maxeval: must be a positive integer, got {merged['maxeval']!r}")
+        value = merged[key]
+        if isinstance(value, bool) or not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
+            raise ValueError(f"options.{key}: must be a positive number, got {value!r}")
+        merged[key] = float(value)
+    value = merged["maxeval"]
+    if isinstance(value, bool) or not (isinstance(value, numbers.Integral) and value > 0):
+        raise ValueError(f"options.maxeval: must be a positive integer, got {value!r}")
+    merged["maxeval"] = int(value)
     return merged
 
 

@@ -5,16 +5,26 @@ campaign loses at most the starts that were running; ``--resume`` skips the fini
 ``start_id`` is the primary key: a start can never be stored twice.  No pickles: vectors are
 JSON, and the campaign config is stored with its SHA-256 so that a resume with a different
 config is refused.
+
+A store is created whole or not at all: it is initialised under a temporary name and linked
+into place, which fails if the name is taken — two processes creating one store cannot both
+succeed, and neither deletes a file it did not make.  Opening checks the file (SQLite header,
+``PRAGMA integrity_check``, tables, schema version) and refuses a damaged one with
+:class:`StoreDamaged`, naming the file.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import errno
 import hashlib
 import json
 import math
+import os
 import sqlite3
-from collections.abc import Iterable, Mapping, Sequence
+import uuid
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +32,36 @@ import numpy as np
 import pandas as pd
 
 SCHEMA_VERSION = 1
+TABLES = ("meta", "campaign", "starts", "checks")
+_HEADER = b"SQLite format 3\x00"
+
+
+class StoreError(ValueError):
+    """A campaign store that cannot be used; the message names the file."""
+
+
+class StoreDamaged(StoreError):
+    """A store file that is not an intact campaign store (truncated, overwritten, garbled)."""
+
+    def __init__(self, path: Path, reason: str) -> None:
+        self.path, self.reason = Path(path), reason
+        super().__init__(f"store: {path} is damaged ({reason}); run again with --fresh to discard it")
+
+
+class DuplicateStart(StoreError, sqlite3.IntegrityError):
+    """A start (or row) that is already in the store; still an ``sqlite3.IntegrityError``."""
+
+
+# SQLite result codes that say nothing about the file's contents: busy, read-only, disk full, ...
+_NOT_DAMAGE = ("SQLITE_BUSY", "SQLITE_LOCKED", "SQLITE_CANTOPEN", "SQLITE_READONLY", "SQLITE_IOERR", "SQLITE_FULL",
+               "SQLITE_PERM", "SQLITE_NOMEM", "SQLITE_INTERRUPT")
+
+
+def _sqlite_error(path: Path, exc: sqlite3.Error, doing: str) -> StoreError:
+    """A store error naming the file: :class:`StoreDamaged`, unless the failure is not the file's contents."""
+    if getattr(exc, "sqlite_errorname", "").startswith(_NOT_DAMAGE):
+        return StoreError(f"store: cannot {doing} {path} ({exc})")
+    return StoreDamaged(path, str(exc))
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -101,6 +141,46 @@ def _initialise(db: sqlite3.Connection, name: str, config: Mapping[str, Any], va
         )
 
 
+def _link_exclusive(src: Path, dst: Path) -> None:
+    """Give ``src`` the name ``dst`` unless ``dst`` exists (``FileExistsError``); never replaces."""
+    taken = f"store: {dst} already exists (another process created it first)"
+    try:
+        os.link(src, dst)
+        return
+    except FileExistsError:
+        raise FileExistsError(taken) from None
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK):
+            raise
+    # a file system without hard links: claim the name exclusively, then fill it
+    try:
+        fd = os.open(dst, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+    except FileExistsError:
+        raise FileExistsError(taken) from None
+    with os.fdopen(fd, "wb") as out, open(src, "rb") as inp:
+        out.write(inp.read())
+
+
+def _check_store(path: Path, db: sqlite3.Connection, expect_config: Mapping[str, Any] | None) -> None:
+    """Refuse a store that is damaged, of another schema version or (``expect_config``) of another config."""
+    problems = [r[0] for r in db.execute("PRAGMA integrity_check").fetchall()]  # quick_check misses index damage
+    if problems != ["ok"]:
+        raise StoreDamaged(path, f"integrity check: {problems[0].splitlines()[-1]}")
+    tables = {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    missing = [t for t in TABLES if t not in tables]
+    if missing:
+        raise StoreDamaged(path, f"no campaign tables {missing}")
+    version = dict(db.execute("SELECT key, value FROM meta").fetchall()).get("schema_version")
+    campaigns = db.execute("SELECT config_hash FROM campaign").fetchall()
+    if version is None or len(campaigns) != 1:
+        raise StoreDamaged(path, "no schema version or campaign record")
+    if version != str(SCHEMA_VERSION):
+        raise StoreError(f"store: schema version {version} in {path}, this railopt reads {SCHEMA_VERSION}")
+    if expect_config is not None and campaigns[0][0] != config_hash(expect_config):
+        raise StoreError(f"store: {path} was made from a different config; refusing to resume it "
+                         "(run again with --fresh to discard it)")
+
+
 class CampaignStore:
     """One campaign's SQLite file.  Use :meth:`create` for a new campaign, :meth:`open` to read/resume."""
 
@@ -111,19 +191,29 @@ class CampaignStore:
     # ------------------------------------------------------------------ opening
     @classmethod
     def create(cls, path: str | Path, name: str, config: Mapping[str, Any], variables: list[str]) -> CampaignStore:
-        """Create a new store; refuses to touch an existing file."""
+        """Create a new store; refuses to touch an existing file (``FileExistsError``)."""
         path = Path(path)
         if path.exists():
             raise FileExistsError(f"store: {path} already exists (resume it, or remove it to start afresh)")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        db = sqlite3.connect(path)
         try:
-            _initialise(db, name, config, variables)
-        except Exception:
-            db.close()
-            path.unlink(missing_ok=True)
-            raise
-        return cls(path, db)
+            path.parent.mkdir(parents=True, exist_ok=True)
+        except (FileExistsError, NotADirectoryError):
+            raise StoreError(f"store: cannot create the folder {path.parent}: a file is in the way") from None
+        # initialise under a name only this call uses, then link it into place: the link fails if
+        # another process got there first, and only our own temporary file is ever removed
+        tmp = path.with_name(f".{path.name}.creating-{os.getpid()}-{uuid.uuid4().hex[:8]}")
+        try:
+            db = sqlite3.connect(tmp)
+            try:
+                _initialise(db, name, config, variables)
+            finally:
+                db.close()
+            _link_exclusive(tmp, path)
+        except sqlite3.Error as exc:
+            raise _sqlite_error(path, exc, "create") from None
+        finally:
+            tmp.unlink(missing_ok=True)
+        return cls(path, sqlite3.connect(path))
 
     @classmethod
     def in_memory(cls, variables: Sequence[str], name: str = "in-memory") -> CampaignStore:
@@ -134,20 +224,33 @@ class CampaignStore:
 
     @classmethod
     def open(cls, path: str | Path, expect_config: Mapping[str, Any] | None = None) -> CampaignStore:
-        """Open an existing store; with ``expect_config`` refuse one made from another config."""
+        """Open an existing store; with ``expect_config`` refuse one made from another config.
+
+        Raises :class:`StoreDamaged` (naming the file) if it is not an intact campaign store.
+        """
         path = Path(path)
         if not path.exists():
             raise FileNotFoundError(f"store: {path} does not exist")
-        db = sqlite3.connect(path)
-        store = cls(path, db)
-        version = int(store.meta()["schema_version"])
-        if version != SCHEMA_VERSION:
+        if not path.is_file():
+            raise StoreDamaged(path, "not a file")
+        with open(path, "rb") as fh:
+            header = fh.read(len(_HEADER))
+        if not header:
+            raise StoreDamaged(path, "empty file")
+        if header != _HEADER:
+            raise StoreDamaged(path, "not an SQLite database: bad header")
+        try:
+            db = sqlite3.connect(f"{path.resolve().as_uri()}?mode=rw", uri=True)
+        except sqlite3.Error as exc:
+            raise _sqlite_error(path, exc, "open") from None
+        try:
+            _check_store(path, db, expect_config)
+        except BaseException as exc:
             db.close()
-            raise ValueError(f"store: schema version {version} in {path}, this railopt reads {SCHEMA_VERSION}")
-        if expect_config is not None and store.config_hash != config_hash(expect_config):
-            db.close()
-            raise ValueError(f"store: {path} was made from a different config; refusing to resume it")
-        return store
+            if isinstance(exc, sqlite3.Error):
+                raise _sqlite_error(path, exc, "read") from None
+            raise
+        return cls(path, db)
 
     def close(self) -> None:
         self._db.close()
@@ -159,9 +262,21 @@ class CampaignStore:
         self.close()
 
     # ------------------------------------------------------------------ writing
+    @contextmanager
+    def _writing(self, what: str) -> Iterator[None]:
+        """One transaction; SQLite failures become a :class:`StoreError` naming the file."""
+        try:
+            with self._db:
+                yield
+        except sqlite3.IntegrityError as exc:
+            raise DuplicateStart(f"store: {self.path}: {what} is already stored ({exc}); is another run writing "
+                                 "to this campaign?") from None
+        except sqlite3.Error as exc:
+            raise _sqlite_error(self.path, exc, f"write {what} to") from None
+
     def add_start(self, start_id: int, origin: str, seed: int, result: Any) -> None:
         """Record one finished start (a :class:`~railopt.design.result.SolveResult`) atomically."""
-        with self._db:
+        with self._writing(f"start {start_id}"):
             self._db.execute(
                 "INSERT INTO starts VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
                 (int(start_id), origin, _vec(result.x0), _vec(result.x), _num(result.value), _num(result.t),
@@ -172,7 +287,7 @@ class CampaignStore:
 
     def add_check(self, start_id: int, name: str, value: float, payload: Mapping[str, Any] | None = None) -> None:
         """Record a check of an optimum (e.g. a critical speed); replaces an earlier one of that name."""
-        with self._db:
+        with self._writing(f"check {name!r} of start {start_id}"):
             self._db.execute(
                 "INSERT OR REPLACE INTO checks VALUES (?,?,?,?)",
                 (int(start_id), name, _num(value), json.dumps(payload or {}, sort_keys=True, default=str)),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -29,8 +30,10 @@ class DesignVariable:
             raise ValueError(f"name: a design variable needs a non-empty name, got {self.name!r}")
         for field_name in ("lower", "upper"):
             v = getattr(self, field_name)
-            if not isinstance(v, int | float) or not math.isfinite(v):
+            # any real number, numpy scalars included (np.float32, np.int64), but not a bool
+            if not isinstance(v, numbers.Real) or isinstance(v, bool | np.bool_) or not math.isfinite(v):
                 raise ValueError(f"{self.name}.{field_name}: must be a finite number, got {v!r}")
+            object.__setattr__(self, field_name, float(v))
         if not self.upper > self.lower:
             raise ValueError(f"{self.name}: bounds inverted or empty, lower {self.lower} ≥ upper {self.upper}")
         if self.scale not in SCALES:

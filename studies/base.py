@@ -59,9 +59,10 @@ class StudyContext:
     """What the CLI hands a study run."""
 
     outdir: Path  # staging folder; published atomically on success
-    store_dir: Path  # persistent folder for resumable state (campaign stores)
+    store_dir: Path  # campaign stores: the study folder (resumable), or the staging folder under --fresh
     workers: int | None = None
     scheduler: str | None = None
+    scheduler_timeout: float | None = None  # s; None: $RAILOPT_SCHEDULER_TIMEOUT or the default
     resume: bool = False
     show_progress: bool = True
 
@@ -104,4 +105,4 @@ def dask_context(context: StudyContext):
     """The dask client for a study run (``None`` = serial when ``workers == 0``)."""
     from railopt.design.parallel import dask_client
 
-    return dask_client(context.workers, context.scheduler)
+    return dask_client(context.workers, context.scheduler, timeout=context.scheduler_timeout)

@@ -17,17 +17,17 @@ from railopt.studies.base import StrictModel, StudyContext
 
 
 class SolverOptions(StrictModel):
-    xtol: float = Field(1e-10, gt=0)
-    ftol: float = Field(1e-12, gt=0)
+    xtol: float = Field(1e-10, gt=0, strict=True)  # strict: `true` is not a number
+    ftol: float = Field(1e-12, gt=0, strict=True)
     maxeval: int = Field(3000, gt=0, strict=True)
-    maxtime: float = Field(120.0, gt=0)
+    maxtime: float = Field(120.0, gt=0, strict=True)
 
 
 class CampaignSettings(StrictModel):
     """The ``[design]`` table shared by campaign studies."""
 
     method: Literal["slsqp", "cobyla", "slp"] = "slsqp"
-    n_starts: int = Field(16, gt=0, strict=True)
+    n_starts: int = Field(16, gt=0, strict=True)  # strict: `true` or 16.0 is not a count
     sampler: Literal["sobol", "lhs"] = "sobol"
     seed: int = Field(0, ge=0, strict=True)
     options: SolverOptions = SolverOptions()

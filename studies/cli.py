@@ -1,27 +1,45 @@
 """The ``railopt`` command: run studies, list them, benchmark the hot paths.
 
 ``railopt run studies/<name>.toml [--workers N] [--scheduler ADDR] [--resume]`` validates the
-config (errors name the field, exit code 2, nothing written), runs the study into a staging
-folder, and publishes the files into ``results/<name>/`` only when the run succeeds.
+config (errors name the field, exit code 2, nothing written), takes the study's lock, runs the
+study into a staging folder, and swaps it in as ``results/<name>/`` only when the run succeeds
+(see :mod:`railopt.studies.publish`).  Every failure a user can cause — a bad config, a damaged
+store, a results folder that cannot be written, a busy study, an unreachable scheduler — ends as
+one line on stderr naming the file, field or address, and exit code 2.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
+import signal
+import sqlite3
 import sys
+import threading
 from pathlib import Path
 
 from railopt import __version__
+from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV, scheduler_timeout
 from railopt.studies.base import StudyContext
 from railopt.studies.config import ConfigError, load_study
+from railopt.studies.publish import (
+    CAMPAIGNS,
+    ResultsError,
+    carry_stores,
+    check_writable,
+    clear_leftovers,
+    ensure_folder,
+    publish,
+    staging_path,
+    study_lock,
+)
 from railopt.studies.report import markdown_table
 
 STUDIES_DIR = Path(__file__).resolve().parent
 EXIT_USAGE = 2
 EXIT_FAILED = 1
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
 
 
 def resolve_study(arg: str) -> Path:
@@ -35,40 +53,54 @@ def resolve_study(arg: str) -> Path:
     raise ConfigError(f"study: no such file {arg!r} (and no bundled study of that name; see `railopt list`)")
 
 
-def _publish(staging: Path, final: Path) -> None:
-    final.mkdir(parents=True, exist_ok=True)
-    for item in sorted(staging.iterdir()):
-        os.replace(item, final / item.name)
-    staging.rmdir()
+def _check_flags(args: argparse.Namespace) -> None:
+    if args.workers is not None and args.workers < 0:
+        raise ConfigError(f"--workers: must be ≥ 0, got {args.workers}")
+    if args.workers is not None and args.scheduler:
+        raise ConfigError("--workers and --scheduler: give one of them (a local cluster or an existing scheduler)")
+    if args.scheduler_timeout is not None:
+        scheduler_timeout(args.scheduler_timeout, "--scheduler-timeout")
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, unwound like Ctrl-C: the staging folder is removed and the study lock released."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise _Terminated
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    kind, config, _ = load_study(resolve_study(args.study))
-    if args.workers is not None and args.workers < 0:
-        raise ConfigError(f"--workers: must be ≥ 0, got {args.workers}")
+    study_file = resolve_study(args.study)
+    kind, config, _ = load_study(study_file)
+    _check_flags(args)
     name = config.study.name
-    results = Path(args.results)
+    results = ensure_folder(Path(args.results))
     final = results / name
-    if args.fresh and (final / "campaigns").exists():
-        shutil.rmtree(final / "campaigns")
-    staging = results / f".staging-{name}-{os.getpid()}"
-    staging.mkdir(parents=True, exist_ok=False)
-    context = StudyContext(
-        outdir=staging,
-        store_dir=final,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        resume=args.resume,
-        show_progress=not args.no_progress,
-    )
-    try:
-        outcome = kind.run(config, context)
-        (staging / "summary.md").write_text(outcome.markdown)
-        shutil.copyfile(resolve_study(args.study), staging / "study.toml")
-        _publish(staging, final)
-    finally:
-        if staging.exists():
-            shutil.rmtree(staging)
+    if final.exists() and not final.is_dir():
+        raise ResultsError(f"results: {final} is a file, not a folder; move it away to publish study {name!r}")
+    check_writable(results, final, final / CAMPAIGNS)  # before hours of work, not when publishing
+    with study_lock(results, name):
+        clear_leftovers(results, name)
+        staging = ensure_folder(staging_path(results, name))
+        context = StudyContext(
+            outdir=staging,
+            store_dir=staging if args.fresh else final,  # --fresh: old stores go only when this run is published
+            workers=args.workers,
+            scheduler=args.scheduler,
+            scheduler_timeout=args.scheduler_timeout,
+            resume=args.resume,
+            show_progress=not args.no_progress,
+        )
+        try:
+            outcome = kind.run(config, context)
+            (staging / "summary.md").write_text(outcome.markdown)
+            shutil.copyfile(study_file, staging / "study.toml")
+            if not args.fresh:
+                carry_stores(final, staging)
+            publish(staging, final)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
     with_pd_options = outcome.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")
     print(f"\n{name}: {kind.summary}\n")
     print(with_pd_options)
@@ -113,10 +145,14 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--workers", type=int, default=None,
                      help="dask worker processes of the embedded LocalCluster (default: CPU count; 0 = serial)")
     run.add_argument("--scheduler", default=None,
-                     help="address of an existing dask scheduler (also $RAILOPT_SCHEDULER)")
+                     help="address of an existing dask scheduler (also $RAILOPT_SCHEDULER, used when neither "
+                          "--scheduler nor --workers is given)")
+    run.add_argument("--scheduler-timeout", type=float, default=None, metavar="SECONDS",
+                     help=f"how long to wait for the scheduler (also ${SCHEDULER_TIMEOUT_ENV}; default 5)")
     stores = run.add_mutually_exclusive_group()
     stores.add_argument("--resume", action="store_true", help="finish an interrupted campaign from its store")
-    stores.add_argument("--fresh", action="store_true", help="discard existing campaign stores of this study first")
+    stores.add_argument("--fresh", action="store_true",
+                        help="start new campaign stores; the old ones are discarded when this run is published")
     run.add_argument("--results", default="results", help="results root folder (default: ./results)")
     run.add_argument("--no-progress", action="store_true", help="no progress bars")
     run.set_defaults(func=cmd_run)
@@ -136,17 +172,36 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line(exc: BaseException) -> str:
+    """The message of a user-caused failure, on one line, naming the file where the error has one."""
+    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        text = f"{exc.filename}: {exc.strerror}"
+    elif isinstance(exc, sqlite3.Error):
+        text = f"store: {exc}"
+    else:
+        text = str(exc) or type(exc).__name__
+    return " ".join(text.split())
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
     try:
         return args.func(args)
-    except (ConfigError, ValueError, FileExistsError, FileNotFoundError) as exc:
-        print(f"railopt: error: {exc}", file=sys.stderr)
+    except (ValueError, OSError, ResultsError, sqlite3.Error) as exc:  # config, store, results folder, scheduler
+        print(f"railopt: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("railopt: interrupted; finished starts are kept in the campaign store; rerun with --resume",
-              file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as exc:
+        if getattr(args, "fresh", False):
+            kept = "the previous results and campaign stores are unchanged (this --fresh run's starts are discarded)"
+        else:
+            kept = "finished starts are kept in the campaign store; rerun with --resume"
+        print(f"railopt: interrupted; {kept}", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(exc, _Terminated) else EXIT_INTERRUPTED
+    finally:
+        if in_main_thread:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

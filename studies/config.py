@@ -39,9 +39,11 @@ def load_study(path: str | Path) -> tuple[StudyKind, BaseModel, dict[str, Any]]:
     if not path.is_file():
         raise ConfigError(f"study: no such file {path}")
     try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        raw = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read the study file ({exc.strerror})") from None
     except UnicodeDecodeError as exc:
-        raise ConfigError(f"{path}: not a text file ({exc.reason} at byte {exc.start})") from None
+        raise ConfigError(f"{path}: not a text file (byte {exc.start} is not UTF-8); a study is a TOML file") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML ({exc})") from None
     header = raw.get("study")

@@ -1,0 +1,71 @@
+"""Fault tests of the dask scheduler choice: a dead scheduler fails fast by name; flags beat the environment."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from faults_cli import STUDY, assert_refused, cli, env, run_args, start_rows, store_path, study_file
+
+from railopt.studies.cli import main
+
+DEAD = "tcp://127.0.0.1:1"  # nothing listens on port 1
+
+
+@pytest.fixture
+def study(tmp_path):
+    return study_file(tmp_path / "study", 3)
+
+
+@pytest.mark.parametrize("how", ["flag", "environment"])
+def test_an_unreachable_scheduler_fails_fast_naming_the_address(how, study, tmp_path):
+    results = tmp_path / "results"
+    if how == "flag":
+        args, environ = run_args(study, results, "--scheduler", DEAD, "--scheduler-timeout", "1", workers=None), env()
+    else:
+        args = run_args(study, results, workers=None)
+        environ = env(RAILOPT_SCHEDULER=DEAD, RAILOPT_SCHEDULER_TIMEOUT="1")
+    began = time.monotonic()
+    done = cli(*args, environ=environ)
+    elapsed = time.monotonic() - began
+    assert_refused(done, f"cannot connect to '{DEAD}' within 1 s", "--workers N")
+    assert elapsed < 15, elapsed  # the issue's run waited 33 s, then printed 66 lines of traceback
+    assert list(results.iterdir()) == []  # nothing published, no staging, lock released
+
+
+@pytest.mark.slow
+def test_the_default_scheduler_timeout_is_a_few_seconds(study, tmp_path):
+    began = time.monotonic()
+    done = cli(*run_args(study, tmp_path / "results", "--scheduler", DEAD, workers=None))
+    elapsed = time.monotonic() - began
+    assert_refused(done, DEAD, "within 5 s")
+    assert 5 <= elapsed < 20, elapsed
+
+
+def test_explicit_workers_0_beats_RAILOPT_SCHEDULER(study, tmp_path):
+    """The environment names a dead scheduler; ``--workers 0`` asks for serial and gets it."""
+    results = tmp_path / "results"
+    done = cli(*run_args(study, results, workers="0"), environ=env(RAILOPT_SCHEDULER=DEAD))
+    assert done.returncode == 0, done.stderr
+    assert [r[0] for r in start_rows(store_path(results))] == [0, 1, 2, 3]
+    assert (results / STUDY / "summary.md").is_file()
+
+
+@pytest.mark.parametrize(
+    ("extra", "environ", "named"),
+    [
+        (["--workers", "1", "--scheduler", DEAD], {}, "--workers and --scheduler"),
+        (["--scheduler", DEAD, "--scheduler-timeout", "0"], {}, "--scheduler-timeout"),
+        (["--scheduler", DEAD], {"RAILOPT_SCHEDULER_TIMEOUT": "soon"}, "RAILOPT_SCHEDULER_TIMEOUT"),
+        (["--scheduler", "nonsense"], {}, "'nonsense' is not a valid address"),
+    ],
+)
+def test_bad_scheduler_flags_are_named(extra, environ, named, study, tmp_path, monkeypatch, capsys):
+    """In-process (quicker): an exception escaping ``main`` would fail the test as a traceback would."""
+    for key, value in environ.items():
+        monkeypatch.setenv(key, value)
+    results = tmp_path / "results"
+    assert main(run_args(study, results, *extra, workers=None)) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("railopt: error:") and err.count("\n") == 1 and named in err, err
+    assert not results.exists() or list(results.iterdir()) == []  # nothing written, lock released
