@@ -30,29 +30,42 @@ DEFAULT_OUTPUT = "output"
 
 @dataclass(frozen=True, eq=False)
 class Output:
-    """One output: the real row ``c`` (n,) and the quantity ``"displacement" | "velocity" |
-    "acceleration"`` of ``c·x`` (units of x, per second, per second squared)."""
+    """One output ``y = c·x + d(Ω)``: the real row ``c`` (n,), the quantity ``"displacement" |
+    "velocity" | "acceleration"`` of y (units of x, per second, per second squared), and an optional
+    feedthrough ``d(Ω)`` of the input itself (a one-component :class:`Forcing`), e.g. the rail
+    displacement subtracted from a body displacement to give a suspension stroke."""
 
     row: np.ndarray
     quantity: str = "displacement"
+    feedthrough: Forcing | None = None
 
     @property
     def order(self) -> int:
         return RESPONSE_ORDER[self.quantity]
 
+    def feedthrough_values(self, omega: np.ndarray) -> np.ndarray:
+        """``d(Ω)`` at the frequencies (zeros without a feedthrough)."""
+        w = np.asarray(omega, dtype=float).ravel()
+        if self.feedthrough is None:
+            return np.zeros(len(w), dtype=complex)
+        return np.array([self.feedthrough.value(float(x))[0] for x in w], dtype=complex)
+
 
 def _output(name: str, spec: object, n: int) -> Output:
+    feedthrough = None
     if isinstance(spec, Output):
-        row, quantity = spec.row, spec.quantity
-    elif isinstance(spec, tuple) and len(spec) == 2 and isinstance(spec[1], str):
-        row, quantity = spec
+        row, quantity, feedthrough = spec.row, spec.quantity, spec.feedthrough
+    elif isinstance(spec, tuple) and len(spec) in (2, 3) and isinstance(spec[1], str):
+        row, quantity, feedthrough = (*spec, None)[:3]
     else:
         row, quantity = spec, "displacement"
     if quantity not in RESPONSE_ORDER:
         raise ValueError(f"{name}.quantity: must be one of {sorted(RESPONSE_ORDER)}, got {quantity!r}")
     arr = real_array(name, row, shape=(n,))
     arr.setflags(write=False)
-    return Output(arr, quantity)
+    if feedthrough is not None:
+        feedthrough = as_forcing(feedthrough, 1, f"{name}.feedthrough")
+    return Output(arr, quantity, feedthrough)
 
 
 def mode_order(s: np.ndarray) -> np.ndarray:
@@ -226,7 +239,8 @@ class LinearSystem:
             else:
                 rows = np.array([o.row for o in self.outputs.values()])
                 orders = np.array([o.order for o in self.outputs.values()])
-                self._pole_residue = PoleResidue(self.M, m, rows, orders, self.forcing)
+                feedthroughs = [o.feedthrough for o in self.outputs.values()]
+                self._pole_residue = PoleResidue(self.M, m, rows, orders, self.forcing, feedthroughs)
         return self._pole_residue
 
     # ------------------------------------------------------------------ frequency response (4.69)
@@ -278,9 +292,22 @@ class LinearSystem:
         rows = np.array([o.row for o in self.outputs.values()])
         orders = np.array([o.order for o in self.outputs.values()])
         with np.errstate(over="ignore", invalid="ignore"):
-            H = (X @ rows.T) * (1j * w[:, None]) ** orders[None, :]
+            H = (X @ rows.T + self._feedthroughs(w)) * (1j * w[:, None]) ** orders[None, :]
         H[~np.isfinite(H)] = np.inf
         return H
+
+    def _feedthroughs(self, w: np.ndarray) -> np.ndarray | float:
+        """``d_o(Ω)`` of every output, (N, m), or 0 when no output has one."""
+        if all(o.feedthrough is None for o in self.outputs.values()):
+            return 0.0
+        return np.column_stack([o.feedthrough_values(w) for o in self.outputs.values()])
+
+    @property
+    def max_delay(self) -> float | None:
+        """Largest declared delay of the forcing and the feedthroughs (s); None if any is undeclared."""
+        delays = [self.forcing.max_delay] + [o.feedthrough.max_delay for o in self.outputs.values()
+                                             if o.feedthrough is not None]
+        return None if any(d is None for d in delays) else max(delays)
 
     def output_index(self, output: str | None) -> int:
         """Column of ``output`` in :meth:`frf_outputs` (0 for the default)."""

@@ -170,7 +170,9 @@ class ParametricSystem:
         X = sla.lu_solve(lu, F, check_finite=False)
         w = sla.lu_solve(lu, rows.T, trans=1, check_finite=False).T  # (m, n) adjoints
         gain = (1j * omega) ** q
-        H = gain * (w @ F)
+        d = np.array([o.feedthrough.value(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])
+        dd = np.array([o.feedthrough.derivative(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])
+        H = gain * (w @ F + d)
         rhs = np.zeros((self.n, len(self.parameters)), dtype=complex)
         for i in range(len(self.parameters)):
             Zi = self._K[i] - omega**2 * self._M[i] + 1j * omega * self._C[i]
@@ -179,7 +181,7 @@ class ParametricSystem:
         dH = gain[:, None] * (w @ rhs)
         dZ = -2 * omega * sys.M + 1j * sys.C
         dgain = np.where(q > 0, q * 1j * (1j * omega) ** np.maximum(q - 1, 0), 0.0)
-        dHw = dgain * (w @ F) + gain * (w @ (sys.forcing.derivative(omega) - dZ @ X))
+        dHw = dgain * (w @ F + d) + gain * (w @ (sys.forcing.derivative(omega) - dZ @ X) + dd)
         return H, dH, dHw
 
     def maxima_jacobians(self, sys: LinearSystem, band: tuple[float, float], exact: bool = False,

@@ -59,8 +59,9 @@ class PoleResidue:
     """``H(Ω)`` of several outputs as sums over the poles of G (see the module docstring)."""
 
     def __init__(self, M: np.ndarray, decomposition: Modal, rows: np.ndarray, orders: np.ndarray,
-                 forcing: Forcing) -> None:
+                 forcing: Forcing, feedthroughs: list[Forcing | None] | None = None) -> None:
         n = M.shape[0]
+        self._feedthroughs = list(feedthroughs or [None] * rows.shape[0])
         self.poles = decomposition.s
         self.orders = np.asarray(orders)
         V, W = decomposition.V, decomposition.W
@@ -94,6 +95,9 @@ class PoleResidue:
             A = np.array([t.function(float(x)) for x in w], dtype=complex)  # (N, n)
             BA = A @ self._B.T  # (N, 2n)
             H += ((P * BA) @ self._Cv.T) * np.exp(-1j * w * t.delay)[:, None]
+        for o, d in enumerate(self._feedthroughs):  # the input's own part of the output: no poles
+            if d is not None:
+                H[:, o] += np.array([d.value(float(x))[0] for x in w], dtype=complex)
         with np.errstate(invalid="ignore", over="ignore"):
             H *= iw[:, None] ** self.orders[None, :]
         H[~np.isfinite(H)] = np.inf

@@ -172,7 +172,7 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
     poles = system.modal().s
     poles = poles[np.abs(poles.real) > UNDAMPED_ROOT * np.abs(poles)]  # their cells are inf anyway
     bounds = np.concatenate([[lo], 0.5 * (clipped[1:] + clipped[:-1]), [hi]])
-    max_delay = system.forcing.max_delay
+    max_delay = system.max_delay
     grid, ratio = band_grid(poles, (lo, hi), max_delay=max_delay or 0.0, extra=np.concatenate([clipped, bounds]))
     pr = system.pole_residue()
     result = _exact_cells(system, pr, grid, bounds, cols)

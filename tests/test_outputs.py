@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from test_parametric import BAND, P0, central_difference
 
-from railopt.models import LinearSystem, ParametricSystem
+from railopt.models import Forcing, LinearSystem, ParametricSystem
 
 from conftest import base_excited_parametric
 
@@ -72,3 +72,41 @@ def test_unknown_output_and_bad_rows_name_the_field():
         LinearSystem(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], outputs={"z": [1j, 0.0]})
     with pytest.raises(ValueError, match=r"^outputs\['z'\].quantity"):
         LinearSystem(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], outputs={"z": ([1.0, 0.0], "jerk")})
+
+
+def test_feedthrough_gives_the_relative_displacement_of_a_base_excited_sdof():
+    """Stroke x − y of m x'' + c(x' − y') + k(x − y) = 0: |X − Y|/|Y| = r²/√((1 − r²)² + (2ζr)²)."""
+    m, k, zeta = 2.0, 800.0, 0.1
+    c = 2 * zeta * np.sqrt(k * m)
+    wn = np.sqrt(k / m)
+    forcing = np.array([[k], [c]], dtype=complex)  # (k + iΩc)·Y, Y = 1
+    sys = LinearSystem([[m]], [[c]], [[k]], Forcing.polynomial(forcing),
+                       outputs={"stroke": ([1.0], "displacement", [-1.0]), "body": ([1.0], "displacement")})
+    w = np.linspace(0.0, 3 * wn, 301)
+    r = w / wn
+    closed = r**2 / np.sqrt((1 - r**2) ** 2 + (2 * zeta * r) ** 2)
+    np.testing.assert_allclose(np.abs(sys.frf(w, "stroke")), closed, rtol=1e-11, atol=1e-14)
+    np.testing.assert_allclose(sys.pole_residue().evaluate(w)[:, 0], sys.frf(w, "stroke"), rtol=1e-10, atol=1e-14)
+    rm = sys.response_maxima((0.0, 3 * wn), exact=True, output="stroke")
+    # closed-form peak of r²/√(...): at r² = 1/(1 − 2ζ²), value 1/(2ζ√(1 − ζ²))
+    assert rm.certified and rm.value == pytest.approx(1 / (2 * zeta * np.sqrt(1 - zeta**2)), rel=1e-10)
+
+
+@pytest.mark.parametrize("exact", [False, True])
+def test_feedthrough_gradients_match_finite_differences(exact):
+    """Base-excited chain with a parametric base spring/damper; stroke output with a feedthrough."""
+    from railopt.models import ParameterPart
+
+    M = np.diag([1.0, 0.5])
+    K0 = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    C0 = 0.02 * K0
+    e0 = np.array([1.0, 0.0])
+    ps = ParametricSystem(M, C0, K0, np.zeros(2), parts={
+        "k_b": ParameterPart(K=np.outer(e0, e0), F=Forcing.polynomial(np.array([e0]))),
+        "c_b": ParameterPart(C=np.outer(e0, e0), F=Forcing.polynomial(np.array([0 * e0, e0]))),
+    }, outputs={"stroke": (e0, "displacement", [-1.0]), "acc": (np.array([0.0, 1.0]), "acceleration")})
+    p = np.array([2.0, 0.1])
+    band = (0.1, 3.0)
+    for name, (_rm, J) in ps.maxima_jacobians(ps.at(p), band, exact=exact).items():
+        Jfd = central_difference(lambda q, name=name: ps.response_maxima(q, band, exact=exact, output=name).values, p)
+        np.testing.assert_allclose(J, Jfd, rtol=2e-5, atol=2e-6 * np.max(np.abs(Jfd)))
