@@ -141,16 +141,35 @@ class Forcing:
 
     @classmethod
     def combine(cls, weighted: Iterable[tuple[float, Forcing]]) -> Forcing:
-        """``Σ w_k F_k`` (parametric forcing); the delays stay declared only if all were."""
-        terms: list[DelayedTerm] = []
+        """``Σ w_k F_k`` (parametric forcing); the delays stay declared only if all were.
+
+        Polynomial terms of equal delay are summed into one (a vehicle's many suspension parameters all
+        act through the same few axle inputs), so evaluating the sum costs one term per distinct delay.
+        """
+        by_delay: dict[float, np.ndarray] = {}
+        others: list[DelayedTerm] = []
         declared = True
         max_delay = 0.0
         for w, f in weighted:
             if w == 0.0:
                 continue
-            terms += [t if w == 1.0 else t.scaled(w) for t in f.terms]
+            for t in f.terms:
+                if t.coefficients is None:
+                    others.append(t if w == 1.0 else t.scaled(w))
+                    continue
+                c = w * t.coefficients
+                acc = by_delay.get(t.delay)
+                if acc is None:
+                    by_delay[t.delay] = c.astype(complex)
+                else:
+                    size = max(acc.shape[0], c.shape[0])
+                    merged = np.zeros((size, c.shape[1]), dtype=complex)
+                    merged[: acc.shape[0]] += acc
+                    merged[: c.shape[0]] += c
+                    by_delay[t.delay] = merged
             declared = declared and f.max_delay is not None
             max_delay = max(max_delay, f.max_delay or 0.0)
+        terms = [DelayedTerm(d, coefficients=c) for d, c in by_delay.items()] + others
         out = cls(terms=terms)
         out.max_delay = max_delay if declared else None
         return out

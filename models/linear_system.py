@@ -145,7 +145,8 @@ class LinearSystem:
         piv = np.abs(np.diag(lu[0]))
         if np.min(piv) <= 1e-14 * max(np.max(piv), 1e-300):
             raise ValueError("M: is singular (a coordinate without inertia); eliminate it first")
-        self._minv_kc = sla.lu_solve(lu, np.hstack([self.K, self.C]), check_finite=False)
+        # numpy's solve: scipy's lu_solve pays a large fixed cost per call on small matrices here
+        self._minv_kc = np.linalg.solve(self.M, np.hstack([self.K, self.C]))
         self._eigvals: np.ndarray | None = None
         self._modal: Modal | None = None
         self._pole_residue: PoleResidue | None | bool = False  # False: not built yet

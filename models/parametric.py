@@ -22,7 +22,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from railopt.models.forcing import Forcing, ForcingLike, as_forcing
 from railopt.models.linear_system import LinearSystem, mode_order
@@ -166,9 +165,8 @@ class ParametricSystem:
         q = np.array([o.order for o in outs])
         Z = sys.impedance(omega)
         F = sys.forcing_at(omega)
-        lu = sla.lu_factor(Z, check_finite=False)
-        X = sla.lu_solve(lu, F, check_finite=False)
-        w = sla.lu_solve(lu, rows.T, trans=1, check_finite=False).T  # (m, n) adjoints
+        X = np.linalg.solve(Z, F)
+        w = np.linalg.solve(Z.T, rows.T).T  # (m, n) adjoints: Zᵀ w = c
         gain = (1j * omega) ** q
         d = np.array([o.feedthrough.value(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])
         dd = np.array([o.feedthrough.derivative(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])

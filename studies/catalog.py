@@ -52,11 +52,14 @@ class ModelSetup:
     speed_model: Callable[[np.ndarray], Any] | None = None
     """For models with forward speed: p -> a model with ``M, K, C_const, C_creep`` whose damping is
     ``C_const + C_creep / S`` (what :mod:`railopt.models.stability` takes)."""
+    aliases: dict[str, str] = field(default_factory=dict)
+    """Readable names of parameters (e.g. ``secondary_lateral_stiffness`` → ``K2``), designable too."""
 
     @property
     def designable(self) -> tuple[str, ...]:
         """Names a study may use as design variables."""
-        return tuple(self.system.parameters) + self.transform_variables
+        return tuple(self.system.parameters) + self.transform_variables + tuple(
+            a for a, k in self.aliases.items() if k in self.system.parameters)
 
     def parameters(self, names: Sequence[str], x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Parameter vector p (P,) for design values ``x`` of ``names``, and dp/dx (P, d)."""
@@ -65,6 +68,7 @@ class ModelSetup:
         J = np.zeros((len(params), len(names)))
         derived = {n: float(v) for n, v in zip(names, x, strict=True) if n in self.transform_variables}
         for j, (n, v) in enumerate(zip(names, x, strict=True)):
+            n = self.aliases.get(n, n)
             if n in params:
                 p[params.index(n)] = v
                 J[params.index(n), j] = 1.0
@@ -103,6 +107,7 @@ def register_model(name: str, options: type[BaseModel], description: str = ""):
 
 def catalog_entry(name: str, field_name: str = "model") -> CatalogEntry:
     import railopt.studies.models  # noqa: F401  (registers the bundled models)
+    import railopt.studies.ride_models  # noqa: F401
 
     if name not in MODELS:
         raise ValueError(f"{field_name}: unknown model {name!r}; known models: {sorted(MODELS)}")

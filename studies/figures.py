@@ -197,37 +197,122 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame) -> Figure:
 TRACK_STYLES = {"rigid": ("C0", "-", 1.4), "flexible": ("C3", "--", 1.4)}
 
 
-def plot_forced_response(series: dict[str, pd.DataFrame], title: str, note: str = "") -> Figure:
-    """Figs 4.5–4.12 style: amplitude (top) and phase (bottom) of one output against the forcing frequency,
-    rigid and flexible track on the same axes.
+def plot_forced_response(series: dict[str, pd.DataFrame], title: str,
+                         peaks: dict[str, tuple[float, float]] | None = None, note: str = "",
+                         log_frequency: bool = False) -> Figure:
+    """Figs 4.5–4.12 style: amplitude of one output against the forcing frequency, rigid and flexible
+    track on the same axes (the thesis plots amplitudes only).
 
     Parameters
     ----------
     series : mapping track -> DataFrame
-        Columns ``frequency_hz``, ``amplitude``, ``phase_deg``, ``unit``, ``output`` (one output).
+        Columns ``frequency_hz``, ``amplitude``, ``unit``, ``output`` (one output).
     title : str
         Figure title (thesis figure label and name).
+    peaks : mapping track -> (value, frequency in Hz), optional
+        Certified band maxima, marked and quoted in the legend.
     note : str
         Caption (model, speed, irregularity).
+    log_frequency : bool
+        Logarithmic frequency axis.
     """
-    fig = Figure(figsize=(7.0, 5.2))
-    ax, axp = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]})
+    fig = Figure(figsize=(7.0, 4.4))
+    ax = fig.subplots()
     unit = output = ""
     for track, d in series.items():
         color, ls, lw = TRACK_STYLES.get(track, ("k", "-", 1.2))
-        f = d["frequency_hz"].to_numpy()
-        i = int(np.argmax(d["amplitude"].to_numpy()))
-        ax.plot(f, d["amplitude"], color=color, ls=ls, lw=lw,
-                label=f"{track} track (max {d['amplitude'].iloc[i]:.4g} at {f[i]:.3g} Hz)")
-        axp.plot(f, d["phase_deg"], color=color, ls="none", marker=".", ms=1.5)
+        label = f"{track} track"
+        if peaks and track in peaks:
+            value, f_peak = peaks[track]
+            label += f" (peak {value:.4g} at {f_peak:.3g} Hz)"
+            ax.plot([f_peak], [value], marker="v", color=color, ms=5, ls="none")
+        ax.plot(d["frequency_hz"], d["amplitude"], color=color, ls=ls, lw=lw, label=label)
         unit, output = d["unit"].iloc[0], d["output"].iloc[0]
     ax.set_ylabel(f"|{output}| ({unit})")
+    ax.set_xlabel("forcing frequency f = S/L (Hz)")
+    if log_frequency:
+        ax.set_xscale("log")
+    ax.set_title(title, fontsize=10)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    _caption(fig, note)
+    return fig
+
+
+def plot_before_after(f_hz: np.ndarray, before: np.ndarray, after: np.ndarray, title: str, ylabel: str) -> Figure:
+    """An output's |H| before and after optimisation against frequency (Figs 4.13–4.16)."""
+    fig = Figure(figsize=(7.0, 4.2))
+    ax = fig.subplots()
+    ax.plot(f_hz, before, "C3-", lw=1.3, label=f"before (peak {np.max(before):.4g})")
+    ax.plot(f_hz, after, "C0-", lw=1.6, label=f"after (peak {np.max(after):.4g})")
+    ax.set_xlabel("forcing frequency (Hz)")
+    ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    axp.set_ylabel("phase (deg)")
-    axp.set_yticks([-180, -90, 0, 90, 180])
-    axp.set_xlabel("forcing frequency f = S/L (Hz)")
-    axp.grid(alpha=0.3)
-    _caption(fig, note)
+    fig.tight_layout()
+    return fig
+
+
+def plot_root_loci_before_after(loci: dict[str, pd.DataFrame], title: str) -> Figure:
+    """Velocity root loci of two designs (Fig 4.17): roots below 25 Hz, coloured by design."""
+    fig = Figure(figsize=(7.0, 4.6))
+    ax = fig.subplots()
+    for (label, d), color in zip(loci.items(), ("C3", "C0"), strict=False):
+        d = d[d["frequency_hz"] < 25]
+        ax.scatter(d["real"], d["frequency_hz"], s=3, color=color, label=label)
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.set_xlim(-15.0, None)
+    ax.set_xlabel("Re s (1/s)")
+    ax.set_ylabel("Im s / 2π (Hz)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, markerscale=4)
+    fig.tight_layout()
+    return fig
+
+
+def plot_tradeoff(table: pd.DataFrame, quantity: str, title: str) -> Figure:
+    """U against a traded quantity: every design, the ε-sweep optima and the non-dominated front."""
+    fig = Figure(figsize=(6.4, 4.4))
+    ax = fig.subplots()
+    starts = table[table["source"] == "start"]
+    sweep = table[table["source"] == "sweep"]
+    front = table[table["nondominated"]].sort_values(quantity)
+    ax.scatter(starts[quantity], starts["U"], s=10, color="0.6", label="campaign starts")
+    ax.scatter(sweep[quantity], sweep["U"], s=18, color="C0", label="ε-constraint optima")
+    ax.plot(front[quantity], front["U"], "C3.-", lw=1.2, label="non-dominated")
+    ax.set_xlabel(quantity)
+    ax.set_ylabel("U (objective)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def plot_surfaces(constrained, unconstrained, title: str) -> Figure:
+    """Fig 4.18: U over two variables as 3-D surfaces and contours, constrained and unconstrained."""
+    fig = Figure(figsize=(12.0, 9.0))
+    for row, (surf, label) in enumerate(((unconstrained, "unconstrained (bounds relaxed toward zero)"),
+                                         (constrained, "constrained (inside the bounds)"))):
+        XI, XJ = np.meshgrid(np.log10(surf.xi), np.log10(surf.xj))
+        Z = np.log10(np.where(np.isfinite(surf.values), surf.values, np.nan))
+        ax = fig.add_subplot(2, 2, 2 * row + 1, projection="3d")
+        ax.plot_surface(XI, XJ, Z, cmap="viridis", linewidth=0, antialiased=True)
+        ax.set_xlabel(f"log10 {surf.names[0]}", fontsize=7)
+        ax.set_ylabel(f"log10 {surf.names[1]}", fontsize=7)
+        ax.set_zlabel("log10 U", fontsize=7)
+        ax.set_title(label, fontsize=9)
+        ax2 = fig.add_subplot(2, 2, 2 * row + 2)
+        cs = ax2.contourf(XI, XJ, Z, levels=20, cmap="viridis")
+        fig.colorbar(cs, ax=ax2, label="log10 U")
+        m = surf.minimum(inside_only=row == 1)
+        ax2.plot(np.log10(m[surf.names[0]]), np.log10(m[surf.names[1]]), "r*", ms=12, label="grid minimum")
+        ax2.set_xlabel(f"log10 {surf.names[0]}")
+        ax2.set_ylabel(f"log10 {surf.names[1]}")
+        ax2.legend(fontsize=8)
+    fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
     return fig

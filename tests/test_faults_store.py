@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-import re
 import random
+import re
 import shutil
 import sqlite3
 from pathlib import Path

@@ -205,6 +205,15 @@ class Vehicle:
         """Lateral (v, α, γ) model: 9 DOF on rigid and 15 on flexible track for the locomotive."""
         return self._block(track, LATERAL_DOFS, speed)
 
+    def cab_lateral(self, cab_input=None):
+        """The thesis's simplified cab model (§4.3.3) at this vehicle's values, a
+        :class:`~railopt.models.LinearSystem` whose first output ``cab_acceleration`` is the cab point's
+        lateral acceleration (m/s²) for the irregularity of ``cab_input`` (default 0.25 in, 0–3 Hz,
+        3 Hz at 150 mph); see :mod:`railopt.models.vehicle.cab`."""
+        from railopt.models.vehicle.cab import CabInput, cab_lateral_model
+
+        return cab_lateral_model(self, cab_input or CabInput()).at()
+
     def vertical(self, track: str = "rigid", speed: float | None = None) -> VehicleModel:
         """Longitudinal–vertical (u, w, β) model: 21 / 27 DOF for the locomotive."""
         return self._block(track, VERTICAL_DOFS, speed)

@@ -35,6 +35,8 @@ from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
 from railopt.studies.figures import plot_frf_panels
 from railopt.studies.problem import ResponseTarget, minimax_problem
 from railopt.studies.report import markdown_table, write_table
+from railopt.studies.ride_report import ride_report
+from railopt.studies.tradeoffs import SurfaceSpec, TradeoffSpec
 
 HZ = 2 * np.pi
 
@@ -93,6 +95,12 @@ class CampaignDesign(CampaignSettings):
 
 class ReportSpec(StrictModel):
     compare: list[str] = Field(default_factory=list, description="named designs reported beside the optima")
+    before: str | None = Field(None, description="a named design reported before/after against the best optimum")
+    outputs: list[str] = Field(default_factory=list, description="outputs shown before/after (default: objective)")
+    inch_outputs: list[str] = Field(default_factory=list, description="outputs also reported in inches (m → in)")
+    locus_speeds_m_s: tuple[float, float] | None = Field(None, description="root locus before/after over speed")
+    published: dict[str, tuple[float, float]] = Field(
+        default_factory=dict, description="output -> published (before, after) peaks, in inches for inch_outputs")
     frf_points: int = Field(800, ge=50, le=20000)
     dpi: int = Field(110, ge=50, le=300)
 
@@ -103,6 +111,8 @@ class CampaignStudyConfig(ModelsStudy):
     constraints: list[ConstraintSpec] = Field(default_factory=list)
     design: CampaignDesign
     report: ReportSpec = ReportSpec()
+    tradeoffs: list[TradeoffSpec] = Field(default_factory=list)
+    surfaces: list[SurfaceSpec] = Field(default_factory=list)
 
     @model_validator(mode="after")
     def _resolve(self) -> CampaignStudyConfig:
@@ -128,7 +138,9 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
     for field, spec in specs:
         if spec.output is not None and spec.output not in outputs:
             raise ValueError(f"{field}.output: unknown output {spec.output!r} of {where}; outputs are {list(outputs)}")
-    for field, named in (("design.start_from", cfg.design.start_from), ("report.compare", cfg.report.compare)):
+    before = [cfg.report.before] if cfg.report.before else []
+    for field, named in (("design.start_from", cfg.design.start_from), ("report.compare", cfg.report.compare),
+                         ("report.before", before)):
         for name in named:
             if name not in setup.named_designs:
                 raise ValueError(f"{field}: {where} has no named design {name!r}; it has {sorted(setup.named_designs)}")
@@ -141,6 +153,21 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
         for v in cfg.design.variables:
             if not (v.lower <= point[v.name] <= v.upper) or not np.isfinite(point[v.name]):
                 raise ValueError(f"design.points[{i}].{v.name}: {point[v.name]} outside [{v.lower}, {v.upper}]")
+    for field, wanted in (("report.outputs", cfg.report.outputs), ("report.inch_outputs", cfg.report.inch_outputs),
+                          ("report.published", list(cfg.report.published)),
+                          ("tradeoffs.output", [t.output for t in cfg.tradeoffs if t.output])):
+        bad = [o for o in wanted if o not in outputs]
+        if bad:
+            raise ValueError(f"{field}: {bad} are not outputs of {where}; outputs are {list(outputs)}")
+    for t in cfg.tradeoffs:
+        if t.check is not None and t.check not in setup.checks:
+            raise ValueError(f"tradeoffs.{t.name}.check: {where} has no check {t.check!r}")
+    for sp in cfg.surfaces:
+        bad = [v for v in sp.variables if v not in names]
+        if bad or sp.variables[0] == sp.variables[1]:
+            raise ValueError(f"surfaces.variables: need two different design variables of {names}, got {sp.variables}")
+    if cfg.report.locus_speeds_m_s is not None and setup.speed_model is None:
+        raise ValueError(f"report.locus_speeds_m_s: {where} has no forward speed")
     for name in cfg.design.checks:
         if name not in setup.checks:
             raise ValueError(f"design.checks: {where} has no check {name!r}; it has {sorted(setup.checks)}")
@@ -203,10 +230,10 @@ def run(config: CampaignStudyConfig, context: StudyContext) -> StudyOutcome:
                 found = check_optima(found, names, label, context, check,
                                      _parameter_check(setup, names, setup.checks[check]), client)
             optima[(model, objective, method)] = found
-
-    rows = [_comparison_row(cfg, setups[m], m, o, meth, tables[(m, o, meth)], optima[(m, o, meth)])
-            for m, o, meth in campaigns]
-    comparison = pd.DataFrame(rows)
+        rows = [_comparison_row(cfg, setups[m], m, o, meth, tables[(m, o, meth)], optima[(m, o, meth)])
+                for m, o, meth in campaigns]
+        comparison = pd.DataFrame(rows)
+        extra_files, extra_md = ride_report(cfg, setups, comparison, tables, context, client)
     starts = pd.concat([t.drop(columns=["functions"], errors="ignore").assign(model=m, objective=o, method=meth)
                         for (m, o, meth), t in tables.items()], ignore_index=True)
     optima_table = pd.concat([t.assign(model=m, objective=o, method=meth) for (m, o, meth), t in optima.items()],
@@ -214,8 +241,9 @@ def run(config: CampaignStudyConfig, context: StudyContext) -> StudyOutcome:
     files = write_table(comparison, context.outdir, "comparison")
     files += write_table(starts, context.outdir, "starts", parquet=True)
     files += write_table(optima_table, context.outdir, "optima")
-    files += _frf_figure(cfg, setups, comparison, context)
-    return StudyOutcome(table=_short(comparison, names), markdown=_markdown(cfg, comparison, names), files=files)
+    files += _frf_figure(cfg, setups, comparison, context) + extra_files
+    markdown = _markdown(cfg, comparison, names) + "\n".join(extra_md)
+    return StudyOutcome(table=_short(comparison, names), markdown=markdown, files=files)
 
 
 def _parameter_check(setup: ModelSetup, names: list[str], check):

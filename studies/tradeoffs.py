@@ -1,0 +1,113 @@
+"""Trade-offs and objective surfaces of a campaign study (thesis §4.3.3, Fig 4.18; SPEC §3).
+
+``[[tradeoffs]]``: ε-constraint sweeps of the campaign's problem — minimise U subject to the response
+maxima of another output below ε (e.g. the secondary lateral stroke), or subject to a check's value above ε
+(e.g. the critical speed from the ``hunting`` check) — and the non-dominated designs among the sweep
+optima *and every start of the campaign*, so no row of a Pareto table is dominated by anything computed.
+
+``[[surfaces]]``: U over a grid of two design variables with the others at the optimum, inside the bounds
+(constrained) and on a grid relaxed toward zero (unconstrained), where the thesis notes the trivial
+optimum of zero stiffness.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import pandas as pd
+from pydantic import Field, model_validator
+
+from railopt.design import MinimaxProblem, epsilon_sweep, nondominated, objective_surface
+from railopt.studies.base import FiniteModel
+from railopt.studies.catalog import ModelSetup
+from railopt.studies.problem import ResponseTarget
+
+
+class TradeoffSpec(FiniteModel):
+    """One ε-constraint sweep: a constraint output (g = its f_k ≤ ε) or a check (value ≥ ε)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
+    output: str | None = None
+    check: str | None = None
+    epsilons: list[float] = Field(min_length=2)
+    method: Literal["slsqp", "cobyla", "slp"] = "slsqp"
+    n_starts: int = Field(4, ge=1, le=1000, strict=True)
+    exact: bool = True
+
+    @model_validator(mode="after")
+    def _one(self) -> TradeoffSpec:
+        if (self.output is None) == (self.check is None):
+            raise ValueError(f"tradeoffs.{self.name}: give exactly one of output or check")
+        if self.check is not None and self.method != "cobyla":
+            raise ValueError(f"tradeoffs.{self.name}.method: a check is not differentiable; use method = 'cobyla'")
+        return self
+
+
+class SurfaceSpec(FiniteModel):
+    """U over two design variables (the others at the optimum); ``relax`` scales the lower bounds of the
+    unconstrained grid toward zero."""
+
+    variables: tuple[str, str]
+    points: int = Field(21, ge=3, le=201, strict=True)
+    relax: float = Field(0.01, gt=0, lt=1)
+
+
+def constrained_problem(problem: MinimaxProblem, setup: ModelSetup, names: list[str], spec: TradeoffSpec,
+                        band: tuple[float, float]) -> MinimaxProblem:
+    """``problem`` with the constraint of ``spec`` (ε set later by the sweep)."""
+    from railopt.studies.problem import _Evaluator
+
+    if spec.output is not None:
+        evaluator = _Evaluator(setup, names)
+        target = ResponseTarget(spec.output, band, spec.exact)
+        return MinimaxProblem(problem.variables, problem._functions, jacobian=problem._jacobian,
+                              constraints=lambda x: evaluator.maxima(x, [target]), constraint_jacobian=True)
+    check = setup.checks[spec.check]
+
+    def negative_check(x: np.ndarray) -> np.ndarray:
+        p, _ = setup.parameters(names, x)
+        value, _ = check(p)
+        return np.array([-value if np.isfinite(value) else -1e12])  # stable over the range: no constraint
+
+    return MinimaxProblem(problem.variables, problem._functions, jacobian=problem._jacobian,
+                          constraints=negative_check)
+
+
+def tradeoff_table(problem: MinimaxProblem, setup: ModelSetup, names: list[str], spec: TradeoffSpec,
+                   band: tuple[float, float], starts: pd.DataFrame, seed: int, client=None) -> pd.DataFrame:
+    """Sweep optima and campaign starts with U and the traded quantity; ``nondominated`` marks the front."""
+    cp = constrained_problem(problem, setup, names, spec, band)
+    eps = [-e for e in spec.epsilons] if spec.check is not None else list(spec.epsilons)
+    sweep = epsilon_sweep(cp, eps, n_starts=spec.n_starts, method=spec.method, seed=seed, client=client)
+    sweep = sweep[sweep["success"]].assign(source="sweep")
+    designs = pd.concat([sweep[[*names, "source"]],
+                         starts[np.isfinite(starts["value"])][names].assign(source="start")], ignore_index=True)
+    # one row per distinct design (many starts find the same optimum)
+    designs = designs.loc[~designs[names].round(9).duplicated()].reset_index(drop=True)
+    quantity = spec.output or spec.check
+    U, q = [], []
+    for _, row in designs.iterrows():
+        ev = cp.evaluate(row[names].to_numpy(float))
+        U.append(ev.value)
+        q.append(float(np.max(ev.g)) if spec.output is not None else -float(ev.g[0]))
+    designs["U"], designs[quantity] = U, q
+    sense = {"U": "min", quantity: "max" if spec.check is not None else "min"}
+    designs["nondominated"] = nondominated(designs, ["U", quantity], sense)
+    return designs
+
+
+def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, optimum: np.ndarray, client=None):
+    """(constrained, unconstrained) :class:`~railopt.design.Surface` of U over ``spec.variables``."""
+    space = problem.space
+    grids = []
+    for relaxed in (False, True):
+        axes = []
+        for name in spec.variables:
+            k = space.names.index(name)
+            lo, hi = space.lower[k], space.upper[k]
+            if relaxed:
+                lo = lo * spec.relax
+            axes.append(np.geomspace(lo, hi, spec.points) if lo > 0 else np.linspace(lo, hi, spec.points))
+        grids.append(objective_surface(problem, spec.variables, axes[0], axes[1], optimum, client=client))
+    return grids[0], grids[1]

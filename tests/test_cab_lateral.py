@@ -1,0 +1,210 @@
+"""The flagship cab model and study (thesis §4.3.3): physics of the cut, the study's promises."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from railopt.design import nondominated
+from railopt.models.vehicle import load_vehicle
+from railopt.models.vehicle.cab import INCH, CabInput, cab_lateral_model
+from railopt.studies.cli import STUDIES_DIR, main
+
+BAND = (0.0, 2 * math.pi * 3.0)
+
+
+def test_quasi_static_input_carries_the_body_with_it():
+    """At Ω → 0 in the fixed-speed reading both trucks move together by the amplitude: the body follows
+    rigidly (cab displacement = amplitude, no roll, no stroke)."""
+    cab = cab_lateral_model(load_vehicle("sd40-2"), CabInput(mode="fixed_speed"))
+    sys = cab.at()
+    amp = 0.25 * INCH
+    assert abs(sys.frf(0.0, "cab_displacement")) == pytest.approx(amp, rel=1e-9)
+    assert abs(sys.frf(0.0, "body_roll")) < 1e-12
+    for frame in cab.frames:
+        assert abs(sys.frf(0.0, f"secondary_stroke_{frame}")) < 1e-12 * amp
+
+
+def test_cut_equals_the_body_block_of_the_lateral_model():
+    """The cab model's M, K, C are the body rows/columns of the full lateral model (the body carries no
+    creep), and its forcing is minus the body-frame coupling times the frame inputs."""
+    v = load_vehicle("sd40-2")
+    lat = v.lateral("rigid", speed=30.0)
+    body = [lat.coordinates.index(f"body.{d}") for d in ("v", "alpha", "gamma")]
+    sys = v.cab_lateral(CabInput(mode="fixed_speed"))
+    blk = np.ix_(body, body)
+    np.testing.assert_allclose(sys.M, lat.M[blk], rtol=1e-14)
+    np.testing.assert_allclose(sys.K, lat.K[blk], rtol=1e-12, atol=1e-6)
+    np.testing.assert_allclose(sys.C, lat.C[blk], rtol=1e-12, atol=1e-9)
+    fronts = [lat.coordinates.index(f"{f}.v") for f in ("frame_front", "frame_rear")]
+    amp = 0.25 * INCH
+    expect = -(lat.K[np.ix_(body, fronts)] @ np.array([amp, amp]))  # Ω = 0: both frames at +amp
+    np.testing.assert_allclose(sys.forcing.value(0.0), expect, rtol=1e-12, atol=1e-9)
+
+
+def test_residual_and_certified_peaks_of_every_output():
+    sys = load_vehicle("sd40-2").cab_lateral()
+    for w in np.linspace(0.0, BAND[1], 7):
+        X = sys.solve(w)
+        F = sys.forcing.value(w)
+        assert np.linalg.norm(sys.impedance(w) @ X - F) <= 1e-10 * np.linalg.norm(F)
+    w = np.linspace(*BAND, 20_001)
+    sampled = np.abs(sys.frf_outputs(w)).max(axis=0)  # direct solves on a uniform grid, every output at once
+    for k, name in enumerate(sys.output_names):
+        rm = sys.response_maxima(BAND, exact=True, output=name)
+        assert rm.certified and sampled[k] * (1 - 1e-12) <= rm.value <= sampled[k] * (1 + 1e-3)
+
+
+def small_flagship(tmp_path: Path, n_starts: int = 2, report: bool = True) -> Path:
+    text = (STUDIES_DIR / "cab_lateral_minimax.toml").read_text()
+    for old, new in {'methods = ["slsqp", "cobyla", "slp"]': 'methods = ["slsqp"]',
+                     "n_starts = 8": f"n_starts = {n_starts}",
+                     "epsilons = [0.004, 0.005, 0.006, 0.008, 0.010, 0.013]": "epsilons = [0.006, 0.010]",
+                     "epsilons = [26.0, 28.0, 30.0, 32.0, 34.0, 36.0]": "epsilons = [28.0, 34.0]",
+                     "points = 21": "points = 5", "n_starts = 3": "n_starts = 1"}.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    if not report:  # the campaign alone: no trade-offs, surfaces or before/after
+        text = text[: text.index("[report]")]
+    path = tmp_path / "cab.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def flagship(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("flagship")
+    study = small_flagship(tmp)
+    assert main(["run", str(study), "--results", str(tmp / "results"), "--workers", "0", "--no-progress"]) == 0
+    return study, tmp / "results" / "cab_lateral_minimax"
+
+
+@pytest.mark.slow
+def test_every_optimum_is_recomputed_by_a_fresh_vehicle(flagship):
+    """U of each distinct optimum = the stored value, from its optima.csv row and a fresh vehicle."""
+    _, out = flagship
+    optima = pd.read_csv(out / "optima.csv")
+    names = ["secondary_lateral_stiffness", "sidebearer1_vertical_stiffness", "lateral_shock_absorber_damping",
+             "rotational_shock_absorber_damping"]
+    assert len(optima) >= 2
+    for _, row in optima.iterrows():
+        vehicle = load_vehicle("sd40-2").with_parameters({n: float(row[n]) for n in names})
+        U = vehicle.cab_lateral().peak(BAND, exact=row["objective"] == "exact")
+        assert U == pytest.approx(row["value"], rel=1e-9)
+        assert "hunting" in row and isinstance(row["stable"], bool | np.bool_)
+
+
+@pytest.mark.slow
+def test_pareto_rows_are_dominated_by_nothing_computed(flagship):
+    """No Pareto row is dominated by another row or by any start in the campaign stores (recomputed here)."""
+    _, out = flagship
+    names = ["secondary_lateral_stiffness", "sidebearer1_vertical_stiffness", "lateral_shock_absorber_damping",
+             "rotational_shock_absorber_damping"]
+    pareto = pd.read_csv(out / "pareto_stroke.csv")
+    assert nondominated(pareto, ["U", "secondary_stroke_frame_front"]).all()
+    starts = []
+    for store in (out / "campaigns").glob("*exact*.sqlite"):
+        with sqlite3.connect(store) as db:
+            cols = [r[1] for r in db.execute("PRAGMA table_info(starts)")]
+            starts += [dict(zip(cols, r, strict=True)) for r in db.execute("SELECT * FROM starts")]
+    assert starts
+    points = []
+    for s in starts:
+        x = dict(zip(names, json.loads(s["x_json"]), strict=True))
+        sys = load_vehicle("sd40-2").with_parameters(x).cab_lateral()
+        points.append((sys.peak(BAND, output="cab_acceleration"),
+                       sys.peak(BAND, output="secondary_stroke_frame_front")))
+    for _, r in pareto.iterrows():
+        for U, stroke in points:
+            dominated = U <= r["U"] and stroke <= r["secondary_stroke_frame_front"] and (
+                U < r["U"] - 1e-12 * r["U"] or stroke < r["secondary_stroke_frame_front"] * (1 - 1e-12))
+            assert not dominated, (r.to_dict(), U, stroke)
+
+
+@pytest.mark.slow
+def test_summary_reports_before_after_and_flags(flagship):
+    _, out = flagship
+    ba = pd.read_csv(out / "before_after.csv").set_index("output")
+    acc = ba.loc["cab_acceleration"]
+    assert acc["after"] < acc["before"] and acc["before_in"] == pytest.approx(acc["before"] / INCH, rel=1e-12)
+    existing = load_vehicle("sd40-2").cab_lateral().peak(BAND, output="cab_acceleration")
+    assert acc["before"] == pytest.approx(existing, rel=1e-12)
+    stab = pd.read_csv(out / "stability.csv").set_index("design")
+    for design in ("before", "after"):
+        crit = min(stab.loc[design, "critical_speed_rigid_m_s"], stab.loc[design, "critical_speed_flexible_m_s"])
+        assert bool(stab.loc[design, "stable"]) == bool(crit > stab.loc[design, "required_speed_m_s"]
+                                                        and stab.loc[design, "least_damping_rigid"] > 0
+                                                        and stab.loc[design, "least_damping_flexible"] > 0)
+    summary = (out / "summary.md").read_text()
+    if not bool(stab.loc["after", "stable"]):
+        assert "flagged" in summary  # a hunting optimum is never silently kept
+
+
+@pytest.mark.slow
+def test_killed_flagship_campaign_resumes_every_start_once(tmp_path):
+    study = small_flagship(tmp_path, n_starts=12, report=False)
+    results = tmp_path / "results"
+    store = results / "cab_lateral_minimax" / "campaigns" / "sd40-2-thesis-slsqp.sqlite"
+    cmd = [sys.executable, "-m", "railopt.studies.cli", "run", str(study), "--results", str(results),
+           "--workers", "0", "--no-progress"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    done = 0
+    while time.time() < deadline and proc.poll() is None and done < 3:
+        try:
+            with sqlite3.connect(f"{store.resolve().as_uri()}?mode=ro", uri=True, timeout=5) as db:
+                done = db.execute("SELECT COUNT(*) FROM starts").fetchone()[0]
+        except sqlite3.Error:
+            done = 0
+        time.sleep(0.05)
+    assert proc.poll() is None, "finished before it could be killed"
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    resumed = subprocess.run([*cmd, "--resume"], capture_output=True, text=True, timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    with sqlite3.connect(store) as db:
+        ids = [r[0] for r in db.execute("SELECT start_id FROM starts ORDER BY start_id")]
+    assert ids == list(range(13))
+
+
+@pytest.mark.slow
+def test_flagship_runs_on_a_separately_started_dask_cluster(tmp_path):
+    """`dask scheduler` and `dask worker` started as their own processes; `--scheduler` runs the campaign there
+    and gives the serial table."""
+    study = small_flagship(tmp_path, report=False)
+    dask = str(Path(sys.executable).parent / "dask")
+    scheduler_file = tmp_path / "scheduler.json"
+    sched = subprocess.Popen([dask, "scheduler", "--scheduler-file", str(scheduler_file), "--port", "0",
+                              "--dashboard-address", ":0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    worker = None
+    try:
+        deadline = time.time() + 60
+        while not scheduler_file.exists() and time.time() < deadline:
+            time.sleep(0.1)
+        address = json.loads(scheduler_file.read_text())["address"]
+        worker = subprocess.Popen([dask, "worker", "--scheduler-file", str(scheduler_file), "--nthreads", "1",
+                                   "--nworkers", "1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(2)
+        assert main(["run", str(study), "--results", str(tmp_path / "cluster"), "--scheduler", address,
+                     "--scheduler-timeout", "30", "--no-progress"]) == 0
+    finally:
+        for p in (worker, sched):
+            if p is not None:
+                p.terminate()
+                p.wait(timeout=30)
+    assert main(["run", str(study), "--results", str(tmp_path / "serial"), "--workers", "0", "--no-progress"]) == 0
+    cols = ["start_id", "value", "status", "evaluations"]
+    a = pd.read_csv(tmp_path / "cluster" / "cab_lateral_minimax" / "starts.csv")
+    b = pd.read_csv(tmp_path / "serial" / "cab_lateral_minimax" / "starts.csv")
+    pd.testing.assert_frame_equal(a[cols], b[cols])
