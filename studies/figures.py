@@ -263,7 +263,8 @@ def plot_root_loci_before_after(loci: dict[str, pd.DataFrame], title: str) -> Fi
         d = d[d["frequency_hz"] < 25]
         ax.scatter(d["real"], d["frequency_hz"], s=3, color=color, label=label)
     ax.axvline(0.0, color="k", lw=0.8)
-    ax.set_xlim(-15.0, None)
+    top = max(float(d["real"].max()) for d in loci.values())
+    ax.set_xlim(-15.0, max(1.2 * top, 1.0))
     ax.set_xlabel("Re s (1/s)")
     ax.set_ylabel("Im s / 2π (Hz)")
     ax.set_title(title, fontsize=10)

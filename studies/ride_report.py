@@ -110,7 +110,7 @@ def _before_after(cfg, setup, model, names, after, band, best, tag, context) -> 
                "before_at_hz": rb.argmax_frequency / HZ, "after_at_hz": ra.argmax_frequency / HZ,
                "certified": rb.certified and ra.certified}
         if o in cfg.report.inch_outputs:
-            row |= {"before_in": rb.value / INCH, "after_in": ra.value / INCH}
+            row |= {"before_in": rb.value / INCH, "after_in": ra.value / INCH}  # in, in/s or in/s² by quantity
         if o in cfg.report.published:
             pb, pa = cfg.report.published[o]
             row |= {"published_before": pb, "published_after": pa, "published_factor": pb / pa}
@@ -133,7 +133,9 @@ def _before_after(cfg, setup, model, names, after, band, best, tag, context) -> 
     # FRFs before/after (Figs 4.13–4.16)
     f_hz = np.linspace(band[0] / HZ, band[1] / HZ, cfg.report.frf_points)
     for o in outputs:
-        scale, unit = (1 / INCH, "in") if o in cfg.report.inch_outputs else (1.0, "SI")
+        quantity = sys_a.outputs[o].quantity
+        suffix = {"displacement": "", "velocity": "/s", "acceleration": "/s²"}[quantity]
+        scale, unit = (1 / INCH, f"in{suffix}") if o in cfg.report.inch_outputs else (1.0, "SI units")
         fig = plot_before_after(f_hz, np.abs(sys_b.frf(f_hz * HZ, o)) * scale, np.abs(sys_a.frf(f_hz * HZ, o)) * scale,
                                 f"{model}: {o} before and after optimisation", f"|{o}| ({unit})")
         fig.savefig(context.outdir / f"{o}_before_after{tag}.png", dpi=cfg.report.dpi)

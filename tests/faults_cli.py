@@ -134,3 +134,20 @@ def read_only(path: Path) -> Iterator[None]:
         yield
     finally:
         subprocess.run(["chattr", "-i", str(path)], check=True)
+
+
+def baseline_fixtures(n_starts: int):
+    """Module fixtures ``published`` (one successful run with ``n_starts``) and ``results`` (a private copy)."""
+    import shutil
+
+    @pytest.fixture(scope="module")
+    def published(tmp_path_factory) -> tuple[Path, Path]:
+        """(study file, results root) of one successful run: the previous results every test starts from."""
+        return publish_baseline(tmp_path_factory.mktemp("published"), n_starts)
+
+    @pytest.fixture
+    def results(published, tmp_path) -> Path:
+        """A private copy of the published results root."""
+        return Path(shutil.copytree(published[1], tmp_path / "results"))
+
+    return published, results

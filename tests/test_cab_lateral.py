@@ -22,6 +22,8 @@ from railopt.models.vehicle.cab import INCH, CabInput, cab_lateral_model
 from railopt.studies.cli import STUDIES_DIR, main
 
 BAND = (0.0, 2 * math.pi * 3.0)
+NAMES = ["secondary_lateral_stiffness", "sidebearer1_vertical_stiffness", "lateral_shock_absorber_damping",
+         "rotational_shock_absorber_damping"]  # the flagship's design variables (element aliases)
 
 
 def test_quasi_static_input_carries_the_body_with_it():
@@ -95,8 +97,7 @@ def test_every_optimum_is_recomputed_by_a_fresh_vehicle(flagship):
     """U of each distinct optimum = the stored value, from its optima.csv row and a fresh vehicle."""
     _, out = flagship
     optima = pd.read_csv(out / "optima.csv")
-    names = ["secondary_lateral_stiffness", "sidebearer1_vertical_stiffness", "lateral_shock_absorber_damping",
-             "rotational_shock_absorber_damping"]
+    names = NAMES
     assert len(optima) >= 2
     for _, row in optima.iterrows():
         vehicle = load_vehicle("sd40-2").with_parameters({n: float(row[n]) for n in names})
@@ -109,8 +110,7 @@ def test_every_optimum_is_recomputed_by_a_fresh_vehicle(flagship):
 def test_pareto_rows_are_dominated_by_nothing_computed(flagship):
     """No Pareto row is dominated by another row or by any start in the campaign stores (recomputed here)."""
     _, out = flagship
-    names = ["secondary_lateral_stiffness", "sidebearer1_vertical_stiffness", "lateral_shock_absorber_damping",
-             "rotational_shock_absorber_damping"]
+    names = NAMES
     pareto = pd.read_csv(out / "pareto_stroke.csv")
     assert nondominated(pareto, ["U", "secondary_stroke_frame_front"]).all()
     starts = []
@@ -130,6 +130,28 @@ def test_pareto_rows_are_dominated_by_nothing_computed(flagship):
             dominated = U <= r["U"] and stroke <= r["secondary_stroke_frame_front"] and (
                 U < r["U"] - 1e-12 * r["U"] or stroke < r["secondary_stroke_frame_front"] * (1 - 1e-12))
             assert not dominated, (r.to_dict(), U, stroke)
+
+
+@pytest.mark.slow
+def test_critical_speed_pareto_rows_are_dominated_by_nothing_computed(flagship):
+    """The same promise for U against the critical speed (maximised): recomputed with the model layer."""
+    from railopt.models.stability import critical_speed
+    from railopt.models.vehicle.cab import MPH
+
+    _, out = flagship
+    names = NAMES
+    pareto = pd.read_csv(out / "pareto_critical_speed.csv")
+    assert nondominated(pareto, ["U", "hunting"], {"hunting": "max"}).all()
+    table = pd.read_csv(out / "tradeoff_critical_speed.csv")
+    for _, row in table[table["source"] == "start"].iterrows():
+        vehicle = load_vehicle("sd40-2").with_parameters({n: float(row[n]) for n in names})
+        U = vehicle.cab_lateral().peak(BAND, output="cab_acceleration")
+        speed = min(critical_speed(vehicle, t, (2 * MPH, 300 * MPH), tol=0.01, grid=16).speed
+                    for t in ("rigid", "flexible"))
+        assert U == pytest.approx(row["U"], rel=1e-9) and speed == pytest.approx(row["hunting"], abs=0.02)
+        for _, r in pareto.iterrows():
+            assert not (U <= r["U"] and speed >= r["hunting"] and (U < r["U"] * (1 - 1e-9) or speed > r["hunting"]
+                                                                     + 0.02)), (r.to_dict(), U, speed)
 
 
 @pytest.mark.slow

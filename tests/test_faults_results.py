@@ -9,7 +9,6 @@ the previous results byte-identical, every finished start kept exactly once.
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import socket
 import sqlite3
@@ -22,11 +21,11 @@ import pytest
 from faults_cli import (
     STUDY,
     assert_refused,
+    baseline_fixtures,
     cli,
     count_starts,
     dead_pid,
     env,
-    publish_baseline,
     read_only,
     run_args,
     snapshot,
@@ -44,16 +43,7 @@ N_STARTS = 24  # + the Den Hartog start: ids 0..24; long enough (~2 s) to be kil
 IDS = list(range(N_STARTS + 1))
 
 
-@pytest.fixture(scope="module")
-def published(tmp_path_factory) -> tuple[Path, Path]:
-    """(study file, results root) of one successful run: the previous results every test starts from."""
-    return publish_baseline(tmp_path_factory.mktemp("published"), N_STARTS)
-
-
-@pytest.fixture
-def results(published, tmp_path) -> Path:
-    """A private copy of the published results root."""
-    return Path(shutil.copytree(published[1], tmp_path / "results"))
+published, results = baseline_fixtures(N_STARTS)
 
 
 def _published_files(results: Path) -> dict[str, bytes]:

@@ -11,7 +11,6 @@ import multiprocessing
 import os
 import random
 import re
-import shutil
 import sqlite3
 from pathlib import Path
 
@@ -19,8 +18,8 @@ import pytest
 from faults_cli import (
     STUDY,
     assert_refused,
+    baseline_fixtures,
     cli,
-    publish_baseline,
     read_only,
     run_args,
     snapshot,
@@ -33,16 +32,7 @@ from railopt.design.store import CampaignStore, StoreDamaged, StoreError
 N_STARTS = 3  # + the Den Hartog start: ids 0..3
 
 
-@pytest.fixture(scope="module")
-def published(tmp_path_factory) -> tuple[Path, Path]:
-    """(study file, results root) of one successful run: the previous results every test starts from."""
-    return publish_baseline(tmp_path_factory.mktemp("published"), N_STARTS)
-
-
-@pytest.fixture
-def results(published, tmp_path) -> Path:
-    """A private copy of the published results root."""
-    return Path(shutil.copytree(published[1], tmp_path / "results"))
+published, results = baseline_fixtures(N_STARTS)
 
 
 def _layout(store: Path) -> tuple[dict[str, int], int]:
