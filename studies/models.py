@@ -95,3 +95,67 @@ def vehicle_lateral_setup(options: VehicleOptions) -> ModelSetup:
 
     setup.checks["spectral_abscissa"] = hunting
     return setup
+
+
+# ---------------------------------------------------------------------------------------------- forced response
+class IrregularityOptions(StrictModel):
+    """A sinusoidal rail irregularity (:class:`railopt.models.vehicle.irregularity.Irregularity`)."""
+
+    kind: Literal["vertical", "alignment", "cross_level", "lateral"] = "vertical"
+    amplitude_m: float = Field(0.00635, gt=0, lt=1.0, allow_inf_nan=False, description="per rail, m")
+    rails: Literal["in_phase", "out_of_phase"] | None = None
+
+
+class VehicleForcedOptions(StrictModel):
+    vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
+    track: Literal["rigid", "flexible"] = "rigid"
+    speed_m_s: float = Field(30.0, gt=0, lt=1000, allow_inf_nan=False, description="forward speed S, m/s")
+    view: Literal["vertical", "lateral"] = "vertical"
+    input: IrregularityOptions = Field(default_factory=IrregularityOptions)
+    outputs: list[str] = Field(default_factory=lambda: ["body.w"], min_length=1,
+                               description="coordinates, named rows or body points '<body>[x,y,z].<x|y|z>'")
+    quantity: Literal["displacement", "velocity", "acceleration"] = "displacement"
+    parameters: dict[str, float] = Field(default_factory=dict, description="values overriding the vehicle file")
+
+
+def vehicle_forced_model(options: VehicleForcedOptions):
+    """``(VehicleModel, Irregularity)`` of the options (errors name the option)."""
+    from railopt.models.vehicle.irregularity import Irregularity
+
+    vehicle = load_vehicle(options.vehicle)
+    if options.parameters:
+        vehicle = vehicle.with_parameters(options.parameters)
+    view = vehicle.vertical if options.view == "vertical" else vehicle.lateral
+    model = view(track=options.track, speed=options.speed_m_s)
+    try:
+        irregularity = Irregularity(options.input.kind, options.input.amplitude_m, options.input.rails)
+    except ValueError as exc:
+        raise ValueError(str(exc)) from None
+    return model, irregularity
+
+
+@register_model("vehicle_forced", VehicleForcedOptions,
+                "a vehicle's vertical or lateral model forced by a delayed sinusoidal rail irregularity "
+                "(4.60)-(4.70); outputs as listed, every suspension element designable")
+def vehicle_forced_setup(options: VehicleForcedOptions) -> ModelSetup:
+    """The forced response as a ParametricSystem in every suspension element (ids), delays declared."""
+    model, irregularity = vehicle_forced_model(options)
+    names = list(model.parts)
+    system = model.forced_parametric(irregularity, names, options.outputs, options.quantity)
+    defaults = np.array([model.values[n] for n in names])
+
+    def speed_model(p: np.ndarray):
+        return model.with_values(dict(zip(names, p, strict=True)))
+
+    setup = ModelSetup(system=system, defaults=defaults,
+                       named_designs={"existing": dict(zip(names, defaults, strict=True))},
+                       description=f"{model.vehicle.name}, {options.view}, {options.track} track, "
+                                   f"S = {options.speed_m_s:g} m/s, {irregularity.label}",
+                       speed_model=speed_model)
+
+    def stability(p: np.ndarray) -> tuple[float, dict[str, bool]]:
+        value = vehicle_abscissa(speed_model(p))  # neutral roots (free fore-aft translation) ignored
+        return value, {"stable": value < 0}
+
+    setup.checks["spectral_abscissa"] = stability
+    return setup

@@ -1,7 +1,8 @@
 """Reduced equations of motion of one block (lateral or longitudinal–vertical), plain numpy.
 
 ``M ẍ + (C0 + Σ p_i C_i + C_creep/S) ẋ + (K0 + Σ p_i K_i) x = F`` (4.50) in the independent
-coordinates x; ``F(Ω) = (K_in + iΩ C_in − Ω² M_in) u`` for prescribed rail inputs u (4.60)–(4.63).
+coordinates x; ``F(Ω) = −(K_in + iΩ C_in − Ω² M_in) u`` for prescribed rail inputs u (4.60)–(4.63)
+(forced response: :mod:`railopt.models.vehicle.response`).
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -46,6 +48,10 @@ class VehicleModel:
         Forward speed S, m/s.
     output_rows : dict
         Named output rows (e.g. ``"cab.lateral"``): displacement of a point = row · x.
+    track : str or None
+        ``"rigid"`` or ``"flexible"`` (set by :class:`~railopt.models.vehicle.Vehicle`).
+    vehicle : Vehicle or None
+        The vehicle the model was built from (geometry for forced-response inputs and outputs).
     """
 
     coordinates: tuple[str, ...]
@@ -64,6 +70,8 @@ class VehicleModel:
     speed: float | None = None
     output_rows: dict[str, np.ndarray] = field(default_factory=dict)
     aliases: dict[str, str] = field(default_factory=dict)
+    track: str | None = None
+    vehicle: Any = field(default=None, compare=False, repr=False)
 
     def _id(self, name: str) -> str:
         return self.aliases.get(name, name)
@@ -139,7 +147,7 @@ class VehicleModel:
         return s[order], vec[: self.n_dof, order]
 
     def input_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(M_in, C_in, K_in)`` at the current values and speed: ``F(Ω) = (K_in + iΩ C_in − Ω² M_in) u``."""
+        """``(M_in, C_in, K_in)`` at the current values and speed: ``F(Ω) = −(K_in + iΩ C_in − Ω² M_in) u``."""
         K_in = self.K_in0.copy()
         C_in = self.C_in0 + self.C_in_creep / self._speed()
         for name, mat in self.in_parts.items():
@@ -174,3 +182,24 @@ class VehicleModel:
             row = self.output_rows[output]
         return ParametricSystem(base.M, base.C, base.K, np.zeros(self.n_dof), row, parts, response=response,
                                 names=list(self.coordinates))
+
+    # ------------------------------------------------------------------ forced response (delegates)
+    def frequency_response(self, frequencies_hz, input, outputs, quantity: str = "displacement"):
+        """Response table to a rail irregularity; see :func:`railopt.models.vehicle.response.frequency_response`."""
+        from railopt.models.vehicle.response import frequency_response
+
+        return frequency_response(self, frequencies_hz, input, outputs, quantity)
+
+    def forced_system(self, input, outputs, quantity: str = "displacement"):
+        """:class:`~railopt.models.LinearSystem` of the forced response; see
+        :func:`railopt.models.vehicle.response.forced_system`."""
+        from railopt.models.vehicle.response import forced_system
+
+        return forced_system(self, input, outputs, quantity)
+
+    def forced_parametric(self, input, names: Sequence[str], outputs, quantity: str = "displacement"):
+        """:class:`~railopt.models.ParametricSystem` of the forced response in suspension parameters ``names``;
+        see :func:`railopt.models.vehicle.response.forced_parametric`."""
+        from railopt.models.vehicle.response import forced_parametric
+
+        return forced_parametric(self, input, names, outputs, quantity)

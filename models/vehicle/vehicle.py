@@ -259,6 +259,7 @@ class Vehicle:
             parts=parts, values=dict(a.values),
             M_in=T.T @ a.M @ E, K_in0=T.T @ a.K0 @ E, C_in0=T.T @ a.C0 @ E, C_in_creep=T.T @ a.C_creep @ E,
             in_parts=in_parts, speed=speed, output_rows=rows, aliases=self.element_aliases(),
+            track=track, vehicle=self,
         )
 
     def _cab_rows(self, a: Assembly, T: np.ndarray) -> dict[str, np.ndarray]:
