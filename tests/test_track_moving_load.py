@@ -108,7 +108,7 @@ def test_resonance_and_supercritical_handling():
         moving_load(b, np.array([0.0]), P, 1.2 * v_cr, method="fourier")
     with pytest.raises(ValueError, match="method"):
         moving_load(b, np.array([0.0]), P, 10.0, method="fft")
-    with pytest.raises(ValueError, match=r"^v must"):
+    with pytest.raises(ValueError, match=r"^v: must"):
         moving_load(b, np.array([0.0]), P, -1.0)
     # undamped supercritical branch = the limit c -> 0+ of the damped solution (radiation condition)
     xi = np.linspace(-6, 6, 41)

@@ -54,7 +54,7 @@ def dynamic_amplification(
             for theta in speed_ratios:
                 theta = float(theta)
                 if not math.isfinite(theta) or theta < 0.0:
-                    raise ValueError(f"speed_ratios must be finite and non-negative, got {theta!r}")
+                    raise ValueError(f"speed_ratios: must be finite and non-negative, got {theta!r}")
                 v = theta * beam.critical_velocity()
                 if zeta == 0.0 and abs(theta - 1.0) <= 1e-6:
                     y_max, x_max = math.inf, 0.0

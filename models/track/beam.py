@@ -25,14 +25,14 @@ if TYPE_CHECKING:
 def _check_finite(name: str, value: float) -> float:
     value = float(value)
     if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
+        raise ValueError(f"{name}: must be a finite number, got {value!r}")
     return value
 
 
 def _check_positive(name: str, value: float) -> float:
     value = _check_finite(name, value)
     if value <= 0.0:
-        raise ValueError(f"{name} must be positive, got {value!r}")
+        raise ValueError(f"{name}: must be positive, got {value!r}")
     return value
 
 
@@ -73,7 +73,7 @@ class Beam:
             object.__setattr__(self, name, _check_positive(name, getattr(self, name)))
         c = _check_finite("c", self.c)
         if c < 0.0:
-            raise ValueError(f"c must be non-negative, got {c!r}")
+            raise ValueError(f"c: must be non-negative, got {c!r}")
         object.__setattr__(self, "c", c)
         n = _check_finite("N", self.N)
         n_cr = self.buckling_load()
@@ -147,9 +147,9 @@ class Beam:
         damping_ratio = _check_finite("damping_ratio", damping_ratio)
         axial_ratio = _check_finite("axial_ratio", axial_ratio)
         if damping_ratio < 0.0:
-            raise ValueError(f"damping_ratio must be non-negative, got {damping_ratio!r}")
+            raise ValueError(f"damping_ratio: must be non-negative, got {damping_ratio!r}")
         if axial_ratio >= 1.0:
-            raise ValueError(f"axial_ratio = N/N_cr must be below 1, got {axial_ratio!r}")
+            raise ValueError(f"axial_ratio: N/N_cr must be below 1, got {axial_ratio!r}")
         EI, m, k = (_check_positive(n, v) for n, v in (("EI", EI), ("m", m), ("k", k)))
         c = damping_ratio * 2.0 * math.sqrt(k * m)
         N = axial_ratio * 2.0 * math.sqrt(k * EI)

@@ -57,9 +57,9 @@ def printed_impulse_constant(beam: Beam) -> float:
 def _check_times(t: np.ndarray | float) -> np.ndarray:
     t = np.asarray(t, dtype=float)
     if not np.all(np.isfinite(t)):
-        raise ValueError("t must contain finite values only")
+        raise ValueError("t: must contain finite values only")
     if np.any(t < 0.0):
-        raise ValueError("t must be non-negative (s)")
+        raise ValueError("t: must be non-negative (s)")
     return t
 
 
@@ -155,10 +155,10 @@ def impulse_response_at_load(
         ``y(0, t)``, m, same shape as ``t``.
     """
     if method not in _METHODS:
-        raise ValueError(f"method must be one of {_METHODS}, got {method!r}")
+        raise ValueError(f"method: must be one of {_METHODS}, got {method!r}")
     impulse = float(impulse)
     if not math.isfinite(impulse):
-        raise ValueError(f"impulse must be a finite number, got {impulse!r}")
+        raise ValueError(f"impulse: must be a finite number, got {impulse!r}")
     t = _check_times(t)
     if method == "closed":
         return _closed(beam, t, impulse)

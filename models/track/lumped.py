@@ -92,10 +92,10 @@ def lumped(beam: Beam, damping_ratio: float, contact_spacing: float = 1.5) -> Lu
     """
     damping_ratio = float(damping_ratio)
     if not math.isfinite(damping_ratio) or damping_ratio < 0.0:
-        raise ValueError(f"damping_ratio must be a finite non-negative number, got {damping_ratio!r}")
+        raise ValueError(f"damping_ratio: must be a finite non-negative number, got {damping_ratio!r}")
     contact_spacing = float(contact_spacing)
     if not math.isfinite(contact_spacing) or contact_spacing <= 0.0:
-        raise ValueError(f"contact_spacing must be a positive length (m), got {contact_spacing!r}")
+        raise ValueError(f"contact_spacing: must be a positive length (m), got {contact_spacing!r}")
     b = beam.beta
     l_e = 2.0 / b
     K_e = 2.0 * beam.k / b

@@ -45,18 +45,18 @@ def _check_load(P: float, v: float) -> tuple[float, float]:
     P = float(P)
     v = float(v)
     if not math.isfinite(P):
-        raise ValueError(f"P must be a finite number, got {P!r}")
+        raise ValueError(f"P: must be a finite number, got {P!r}")
     if not math.isfinite(v):
-        raise ValueError(f"v must be a finite number, got {v!r}")
+        raise ValueError(f"v: must be a finite number, got {v!r}")
     if v < 0.0:
-        raise ValueError(f"v must be non-negative (the load moves towards +x), got {v!r}")
+        raise ValueError(f"v: must be non-negative (the load moves towards +x), got {v!r}")
     return P, v
 
 
 def _check_xi(xi: np.ndarray | float, name: str = "xi") -> np.ndarray:
     arr = np.asarray(xi, dtype=float)
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must contain finite values only")
+        raise ValueError(f"{name}: must contain finite values only")
     return arr
 
 
@@ -390,7 +390,7 @@ def moving_load(
         with ``c = 0`` and ``v >= v_cr``.
     """
     if method not in _METHODS:
-        raise ValueError(f"method must be one of {_METHODS}, got {method!r}")
+        raise ValueError(f"method: must be one of {_METHODS}, got {method!r}")
     P, v = _check_load(P, v)
     xi = _check_xi(xi)
     if method == "closed":

@@ -107,7 +107,7 @@ class DistributedImpulse:
         for name in ("impulse_per_length", "x1", "x2"):
             object.__setattr__(self, name, _check_finite(name, getattr(self, name)))
         if not self.x2 > self.x1:
-            raise ValueError(f"x2 must be greater than x1, got x1={self.x1!r}, x2={self.x2!r}")
+            raise ValueError(f"x2: must be greater than x1, got x1={self.x1!r}, x2={self.x2!r}")
 
 
 Load = MovingLoad | ImpulseLoad | DistributedImpulse
@@ -271,19 +271,19 @@ def transient(
     x = np.atleast_1d(np.asarray(x, dtype=float))
     t = np.atleast_1d(np.asarray(t, dtype=float))
     if x.ndim != 1 or not np.all(np.isfinite(x)):
-        raise ValueError("x must be a 1-D array of finite positions (m)")
+        raise ValueError("x: must be a 1-D array of finite positions (m)")
     if t.ndim != 1 or not np.all(np.isfinite(t)) or np.any(t < 0.0):
-        raise ValueError("t must be a 1-D array of finite, non-negative times (s)")
+        raise ValueError("t: must be a 1-D array of finite, non-negative times (s)")
     if np.any(np.diff(t) < 0.0):
-        raise ValueError("t must be ascending")
+        raise ValueError("t: must be ascending")
     if not isinstance(load, (MovingLoad, ImpulseLoad, DistributedImpulse)):
-        raise ValueError(f"load must be MovingLoad, ImpulseLoad or DistributedImpulse, got {type(load)!r}")
+        raise ValueError(f"load: must be MovingLoad, ImpulseLoad or DistributedImpulse, got {type(load)!r}")
     point = isinstance(load, MovingLoad)
     if kappa_max_factor is None:
         kappa_max_factor = 16.0 if point else 60.0
     kappa_max_factor = _check_finite("kappa_max_factor", kappa_max_factor)
     if kappa_max_factor < 4.0:
-        raise ValueError(f"kappa_max_factor must be at least 4, got {kappa_max_factor!r}")
+        raise ValueError(f"kappa_max_factor: must be at least 4, got {kappa_max_factor!r}")
     kappa_max = kappa_max_factor * beam.beta
     kappa = _grid(beam, x, t, load, kappa_max)
     dk = kappa[1] - kappa[0]
