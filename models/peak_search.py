@@ -17,6 +17,7 @@ import numpy as np
 INV_PHI = (np.sqrt(5.0) - 1.0) / 2.0
 BRACKET_RTOL = 1e-6  # stop when the best point is located to this fraction of its bracket (value error ~1e-13)
 MAX_ITERATIONS = 80
+SCALAR_CELLS = 12  # up to this many cells, refine each with the scalar Brent (no numpy overhead per step)
 
 
 def bracketed_maximum(fun: Callable[[np.ndarray], np.ndarray], lower: np.ndarray, upper: np.ndarray,
@@ -87,8 +88,62 @@ def bracketed_maximum(fun: Callable[[np.ndarray], np.ndarray], lower: np.ndarray
     return x, -fx
 
 
+def brent_maximum(fun: Callable[[float], float], lower: float, upper: float,
+                  rtol: float = BRACKET_RTOL) -> tuple[float, float]:
+    """Scalar twin of :func:`bracketed_maximum` (same algorithm, plain floats): for a few brackets of a cheap
+    scalar function it avoids numpy's per-call overhead."""
+    a, b = float(lower), float(upper)
+    g = 1.0 - INV_PHI
+    tol1 = max(rtol * (b - a), 4 * np.finfo(float).eps * max(abs(a), abs(b))) / 3.0
+    x = w = v = a + g * (b - a)
+    fx = fw = fv = -fun(x)
+    d = e = 0.0
+    for _ in range(MAX_ITERATIONS):
+        xm = 0.5 * (a + b)
+        tol2 = 2.0 * tol1
+        if abs(x - xm) <= tol2 - 0.5 * (b - a):
+            break
+        para = False
+        if abs(e) > tol1:
+            r = (x - w) * (fx - fv)
+            q = (x - v) * (fx - fw)
+            p = (x - v) * q - (x - w) * r
+            q = 2.0 * (q - r)
+            if q > 0:
+                p = -p
+            q = abs(q)
+            if q != 0 and abs(p) < abs(0.5 * q * e) and q * (a - x) < p < q * (b - x):
+                para = True
+                e, d = d, p / q
+                u = x + d
+                if u - a < tol2 or b - u < tol2:
+                    d = tol1 if xm >= x else -tol1
+        if not para:
+            e = (a - x) if x >= xm else (b - x)
+            d = g * e
+        u = x + (d if abs(d) >= tol1 else (tol1 if d >= 0 else -tol1))
+        fu = -fun(u)
+        if fu <= fx:
+            if u >= x:
+                a = x
+            else:
+                b = x
+            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
+        else:
+            if u < x:
+                a = u
+            else:
+                b = u
+            if fu <= fw or w == x:
+                v, fv, w, fw = w, fw, u, fu
+            elif fu <= fv or v == x or v == w:
+                v, fv = u, fu
+    return x, -fx
+
+
 def cell_maxima(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, values: np.ndarray,
-                boundaries: np.ndarray, rtol: float = BRACKET_RTOL) -> tuple[np.ndarray, np.ndarray]:
+                boundaries: np.ndarray, rtol: float = BRACKET_RTOL,
+                scalar: Callable[[float], float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Maximum of ``fun`` over each cell ``[boundaries[j], boundaries[j+1]]``.
 
     ``grid`` (sorted, containing every boundary) and ``values = fun(grid)`` are the caller's
@@ -130,8 +185,12 @@ def cell_maxima(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, value
         # −1/f² has the same maximiser as f > 0 and is exactly a parabola near a resonance of one
         # pole (|H|² ∝ 1/((Ω−ω)² + σ²)), so the parabolic steps converge in a few iterations
         positive = bool(np.all(values[np.isfinite(values)] > 0))
-        target = (lambda w: -1.0 / np.square(fun(w))) if positive else fun
-        xr, _ = bracketed_maximum(target, lo[idx], hi[idx], rtol)
+        if scalar is not None and idx.size <= SCALAR_CELLS:
+            target_s = (lambda w: -1.0 / scalar(w) ** 2) if positive else scalar
+            xr = np.array([brent_maximum(target_s, lo[i], hi[i], rtol)[0] for i in idx])
+        else:
+            target = (lambda w: -1.0 / np.square(fun(w))) if positive else fun
+            xr, _ = bracketed_maximum(target, lo[idx], hi[idx], rtol)
         fr = fun(xr)
         better = fr > f[idx]
         x[idx] = np.where(better, xr, x[idx])

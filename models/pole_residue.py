@@ -19,6 +19,8 @@ direct solves.
 
 from __future__ import annotations
 
+import cmath
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,6 +79,35 @@ class PoleResidue:
             BA = self._B @ t.coefficients.T  # (2n, p+1)
             R[:, :, ti, : BA.shape[1]] = self._Cv.T[:, :, None] * BA[:, None, :]
         self._R = R
+
+    def scalar_magnitude(self, output: int):
+        """A pure-Python ``Ω -> |H_output(Ω)|`` (no numpy call per frequency: a few microseconds for small n),
+        or ``None`` when the forcing has callable terms or the output a feedthrough."""
+        if self._callables or self._feedthroughs[output] is not None:
+            return None
+        poles = [complex(p) for p in self.poles]
+        k, _, T, J = self._R.shape
+        residues = [[[complex(self._R[kk, output, t, j]) for kk in range(k)] for j in range(J)] for t in range(T)]
+        delays = [float(d) for d in self._delays]
+        q = int(self.orders[output])
+
+        def magnitude(omega: float) -> float:
+            iw = 1j * omega
+            try:
+                inv = [1.0 / (iw - p) for p in poles]
+            except ZeroDivisionError:
+                return math.inf
+            h = 0j
+            for t in range(T):
+                term, power = 0j, 1.0 + 0j
+                for j in range(J):
+                    term += power * sum(r * i for r, i in zip(residues[t][j], inv, strict=True))
+                    power *= iw
+                h += term * cmath.exp(-1j * omega * delays[t]) if delays[t] else term
+            value = abs(h * iw**q)
+            return value if math.isfinite(value) else math.inf
+
+        return magnitude
 
     def evaluate(self, omega: np.ndarray) -> np.ndarray:
         """``H`` at frequencies ``omega`` (rad/s, 1-D), shape (len(omega), m); inf at a pole."""

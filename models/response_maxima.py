@@ -175,12 +175,11 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
     max_delay = system.max_delay
     grid, ratio = band_grid(poles, (lo, hi), max_delay=max_delay or 0.0, extra=np.concatenate([clipped, bounds]))
     pr = system.pole_residue()
-    result = _exact_cells(system, pr, grid, bounds, cols)
+    result = _exact_cells(system, pr, grid, bounds, cols, edges)
     if result is None:  # pole–residue inconsistent with direct solves at a maximum: sample directly
         pr = None
-        result = _exact_cells(system, None, grid, bounds, cols)
-    cell_f, cell_x, all_finite = result
-    edge_vals = _finite_or_inf(np.abs(system.frf_outputs(edges)))
+        result = _exact_cells(system, None, grid, bounds, cols, edges)
+    cell_f, cell_x, all_finite, edge_vals = result
     certified = bool(all_finite and max_delay is not None and ratio <= CERTIFIED_RATIO * (1 + 1e-9))
     out = {}
     for i, (nm, c) in enumerate(zip(names, cols, strict=True)):
@@ -195,18 +194,22 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
     return out
 
 
-def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
-                 cols: list[int]) -> tuple[np.ndarray, np.ndarray, bool] | None:
-    """Cell maxima (values by direct solves at the refined frequencies) for each output column."""
+def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray, cols: list[int],
+                 edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool, np.ndarray] | None:
+    """Cell maxima (values by direct solves at the refined frequencies) for each output column, and |H| at
+    the band edges (the same batch of direct solves)."""
     sample = system.frf_outputs if pr is None else pr.evaluate
     mags = _finite_or_inf(np.abs(sample(grid)))
     xs, fs = [], []
     for c in cols:
-        x, f = cell_maxima(lambda w, c=c: _finite_or_inf(np.abs(sample(w)[:, c])), grid, mags[:, c], bounds)
+        scalar = None if pr is None else pr.scalar_magnitude(c)
+        x, f = cell_maxima(lambda w, c=c: _finite_or_inf(np.abs(sample(w)[:, c])), grid, mags[:, c], bounds,
+                           scalar=scalar)
         xs.append(x)
         fs.append(f)
     X = np.array(xs)
-    direct = _finite_or_inf(np.abs(system.frf_outputs(X.ravel())))
+    direct = _finite_or_inf(np.abs(system.frf_outputs(np.concatenate([X.ravel(), edges]))))
+    edge_vals, direct = direct[-len(edges):], direct[: -len(edges)]
     F = np.array([direct[i * X.shape[1]:(i + 1) * X.shape[1], c] for i, c in enumerate(cols)])
     if pr is not None:
         sampled = np.array(fs)
@@ -214,7 +217,7 @@ def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
         scale = np.max(np.where(ok, F, 0.0), initial=0.0)
         if np.any(np.abs(sampled[ok] - F[ok]) > CONSISTENCY_RTOL * max(scale, 1e-300)):
             return None
-    return F, X, bool(np.all(np.isfinite(mags[:, cols])))
+    return F, X, bool(np.all(np.isfinite(mags[:, cols]))), edge_vals
 
 
 def _finite_or_inf(a: np.ndarray) -> np.ndarray:
