@@ -9,29 +9,21 @@ is asserted and the comment says why.
 
 from __future__ import annotations
 
-import tomllib
 from math import cos, sin
 
 import numpy as np
 import pytest
-
-from railopt.models.vehicle import THESIS_SIGNS, parse_vehicle
-from railopt.models.vehicle.geometry import split
-from railopt.models.vehicle.loader import bundled_path
+from printed_matrices import PrintedMatrices
 
 S = 37.3  # forward speed, m/s
 
 
-class Thesis:
+class Thesis(PrintedMatrices):
     """Entries of our full matrices in thesis coordinates (sums of our coordinates for merged ones)."""
 
-    def __init__(self, seed: int) -> None:
-        rng = np.random.default_rng(seed)
-        data = tomllib.loads(bundled_path("sd40-2").read_text())
-        lengths = {k: float(rng.uniform(0.1, 2.0)) for k in data["lengths"]}
-        lengths["l3"] = float(rng.uniform(5.0, 8.0))
-        data["lengths"] = lengths
-        self.l = lengths
+    speed = S
+
+    def customise(self, rng: np.random.Generator, data: dict) -> None:
         self.a1, self.a2 = (float(rng.uniform(5.0, 85.0)) for _ in range(2))
         data["angles_deg"] = {"alpha1": self.a1, "alpha2": self.a2}
         self.a1, self.a2 = np.radians(self.a1), np.radians(self.a2)
@@ -46,24 +38,6 @@ class Thesis:
         self.f1, self.f2, self.f23, self.f3 = f["f11_N"], f["f22_N"], f["f23_N_m"], f["f33_N_m2"]
         self.f32 = -self.f23
         self.W = self.contact["axle_load_N"]
-        vehicle = parse_vehicle(data)
-        self.p = {k: float(rng.uniform(1e4, 5e6)) for k in vehicle.element_ids()}
-        self.vehicle = vehicle.with_parameters(self.p)
-        a = self.vehicle.assembly("flexible")
-        self.index = {c: i for i, c in enumerate(a.coordinates)}
-        d = np.array([THESIS_SIGNS[split(c)[1]] for c in a.coordinates])
-        self.mats = {"M": a.M * np.outer(d, d), "K": a.K() * np.outer(d, d), "C": a.C(S) * np.outer(d, d)}
-        self.lt = self.vehicle.lumped_track()
-        self.body = {b.name: b for b in self.vehicle.bodies}
-
-    def vec(self, coords: str) -> np.ndarray:
-        v = np.zeros(len(self.index))
-        for c in coords.split("+"):
-            v[self.index[c.strip()]] = 1.0
-        return v
-
-    def __call__(self, mat: str, row: str, col: str) -> float:
-        return float(self.vec(row) @ self.mats[mat] @ self.vec(col))
 
 
 @pytest.fixture(scope="module", params=[11, 12])

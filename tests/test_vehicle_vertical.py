@@ -18,53 +18,32 @@ import tomllib
 
 import numpy as np
 import pytest
+from printed_matrices import PrintedMatrices
 
-from railopt.models.vehicle import THESIS_SIGNS, load_vehicle, parse_vehicle
+from railopt.models.vehicle import THESIS_SIGNS, load_vehicle
 from railopt.models.vehicle.geometry import split
 from railopt.models.vehicle.loader import bundled_path
 
 S = 31.7  # forward speed, m/s
 
 
-class Printed:
+class Printed(PrintedMatrices):
     """Our assembled (all-coordinate) matrices in thesis signs, sums of coordinates for merged ones."""
 
-    def __init__(self, seed: int) -> None:
-        rng = np.random.default_rng(seed)
-        data = tomllib.loads(bundled_path("sd40-2").read_text())
-        lengths = {k: float(rng.uniform(0.1, 2.0)) for k in data["lengths"]}
-        lengths["l3"] = float(rng.uniform(5.0, 8.0))
-        data["lengths"] = lengths
-        self.l = lengths
+    speed = S
+
+    def customise(self, rng: np.random.Generator, data: dict) -> None:
         f = {"f11_N": float(rng.uniform(1e6, 2e7)), "f22_N": float(rng.uniform(1e6, 2e7)),
              "f23_N_m": float(rng.uniform(1e3, 1e5)), "f33_N_m2": float(rng.uniform(10.0, 1e3))}
         data["contact"] = {"wheel_radius_m": "l20", "semi_gauge_m": "l18 / 2", "creep": "given", "spin": True,
                            "gravity_stiffness": True, "conicity": 0.07, "theta0": 0.03, "epsilon": 0.05,
                            "eta": 0.01, "axle_load_N": 2.5e5, **f}
         self.f1 = f["f11_N"]
-        vehicle = parse_vehicle(data)
-        self.p = {k: float(rng.uniform(1e4, 5e6)) for k in vehicle.element_ids()}
-        self.vehicle = vehicle.with_parameters(self.p)
-        a = self.vehicle.assembly("flexible")
-        self.index = {c: i for i, c in enumerate(a.coordinates)}
-        d = np.array([THESIS_SIGNS[split(c)[1]] for c in a.coordinates])
-        self.mats = {"M": a.M * np.outer(d, d), "K": a.K() * np.outer(d, d), "C": a.C(S) * np.outer(d, d)}
-        self.lt = self.vehicle.lumped_track()
-        self.body = {b.name: b for b in self.vehicle.bodies}
         L = self.l
         self.l35 = L["l22"]
         self.nose = {1: L["l24"] - L["l34"] - L["l22"], 2: L["l34"] + L["l22"] - L["l26"],
                      3: L["l23"] + L["l34"] + L["l22"]}
         self.nose.update({4: self.nose[3], 5: self.nose[2], 6: self.nose[1]})
-
-    def vec(self, coords: str) -> np.ndarray:
-        v = np.zeros(len(self.index))
-        for c in coords.split("+"):
-            v[self.index[c.strip()]] = 1.0
-        return v
-
-    def __call__(self, mat: str, row: str, col: str) -> float:
-        return float(self.vec(row) @ self.mats[mat] @ self.vec(col))
 
 
 @pytest.fixture(scope="module", params=[21, 22])
