@@ -81,8 +81,14 @@ class MinimaxProblem:
 
     def with_epsilon(self, epsilon: float | Sequence[float]) -> MinimaxProblem:
         """The same problem with another right-hand side ε of g(x) ≤ ε (ε-constraint sweeps)."""
-        return MinimaxProblem(self.variables, self._functions, self._jacobian, self._constraints,
-                              self._constraint_jacobian, epsilon, self.fd_step)
+        return self.with_constraints(self._constraints, self._constraint_jacobian, epsilon)
+
+    def with_constraints(self, constraints: VectorFunction | None,
+                         constraint_jacobian: VectorFunction | bool | None = None,
+                         epsilon: float | Sequence[float] = 0.0) -> MinimaxProblem:
+        """The same objective subject to other constraints g(x) ≤ ε (conventions as in the constructor)."""
+        return MinimaxProblem(self.variables, self._functions, self._jacobian, constraints, constraint_jacobian,
+                              epsilon, self.fd_step)
 
     @property
     def variables(self) -> tuple[DesignVariable, ...]:

@@ -71,9 +71,7 @@ def minimax_problem(
     evaluator = _Evaluator(setup, names)
     if not constraints:
         return MinimaxProblem(list(variables), lambda x: evaluator.maxima(x, [objective]), jacobian=True)
-    sys = setup.system.at(setup.defaults)
-    n_k = sys.n + 2
-    epsilon = np.repeat(np.asarray(limits, dtype=float), n_k)
+    epsilon = np.repeat(np.asarray(limits, dtype=float), setup.system.n + 2)  # n + 2 maxima per constraint
     return MinimaxProblem(
         list(variables),
         lambda x: evaluator.maxima(x, [objective]),

@@ -48,7 +48,8 @@ def ride_report(cfg, setups, comparison: pd.DataFrame, tables: dict, context, cl
         starts = pd.concat([t for (mm, oo, _), t in tables.items() if mm == model and oo == objective])
         hunting_after = _after_check(cfg, setup, names, after)
         for spec in cfg.tradeoffs:
-            table = tradeoff_table(problem, setup, names, spec, band, starts, cfg.design.seed, client)
+            target = cfg.objective.target(setup, exact=objective == "exact")
+            table = tradeoff_table(problem, setup, target, spec, band, starts, cfg.design.seed, client)
             quantity = spec.output or spec.check
             files += write_table(table, context.outdir, f"tradeoff_{spec.name}{tag}")
             front = table[table["nondominated"]].sort_values("U")

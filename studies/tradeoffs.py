@@ -21,7 +21,7 @@ from pydantic import Field, model_validator
 from railopt.design import MinimaxProblem, epsilon_sweep, nondominated, objective_surface
 from railopt.studies.base import FiniteModel
 from railopt.studies.catalog import ModelSetup
-from railopt.studies.problem import ResponseTarget
+from railopt.studies.problem import ResponseTarget, minimax_problem
 
 
 class TradeoffSpec(FiniteModel):
@@ -53,16 +53,14 @@ class SurfaceSpec(FiniteModel):
     relax: float = Field(0.01, gt=0, lt=1)
 
 
-def constrained_problem(problem: MinimaxProblem, setup: ModelSetup, names: list[str], spec: TradeoffSpec,
-                        band: tuple[float, float]) -> MinimaxProblem:
-    """``problem`` with the constraint of ``spec`` (ε set later by the sweep)."""
-    from railopt.studies.problem import _Evaluator
-
+def constrained_problem(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget,
+                        spec: TradeoffSpec, band: tuple[float, float]) -> MinimaxProblem:
+    """``problem`` with the constraint of ``spec`` (ε set later by the sweep).  An output constraint goes
+    through the one adapter, so objective and constraint share each x's system and eigen-decomposition."""
+    names = list(problem.space.names)
     if spec.output is not None:
-        evaluator = _Evaluator(setup, names)
         target = ResponseTarget(spec.output, band, spec.exact)
-        return MinimaxProblem(problem.variables, problem._functions, jacobian=problem._jacobian,
-                              constraints=lambda x: evaluator.maxima(x, [target]), constraint_jacobian=True)
+        return minimax_problem(setup, problem.variables, objective, [target], [0.0])
     check = setup.checks[spec.check]
 
     def negative_check(x: np.ndarray) -> np.ndarray:
@@ -70,14 +68,14 @@ def constrained_problem(problem: MinimaxProblem, setup: ModelSetup, names: list[
         value, _ = check(p)
         return np.array([-value if np.isfinite(value) else -1e12])  # stable over the range: no constraint
 
-    return MinimaxProblem(problem.variables, problem._functions, jacobian=problem._jacobian,
-                          constraints=negative_check)
+    return problem.with_constraints(negative_check)
 
 
-def tradeoff_table(problem: MinimaxProblem, setup: ModelSetup, names: list[str], spec: TradeoffSpec,
+def tradeoff_table(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget, spec: TradeoffSpec,
                    band: tuple[float, float], starts: pd.DataFrame, seed: int, client=None) -> pd.DataFrame:
     """Sweep optima and campaign starts with U and the traded quantity; ``nondominated`` marks the front."""
-    cp = constrained_problem(problem, setup, names, spec, band)
+    names = list(problem.space.names)
+    cp = constrained_problem(problem, setup, objective, spec, band)
     eps = [-e for e in spec.epsilons] if spec.check is not None else list(spec.epsilons)
     sweep = epsilon_sweep(cp, eps, n_starts=spec.n_starts, method=spec.method, seed=seed, client=client)
     sweep = sweep[sweep["success"]].assign(source="sweep")
