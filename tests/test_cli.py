@@ -47,6 +47,7 @@ BAD = {
     "unknown named start": ({'start_from = ["den_hartog"]': 'start_from = ["existing"]'}, "", "design.start_from"),
     "unknown check": ({'checks = ["spectral_abscissa"]': 'checks = ["hunting"]'}, "", "design.checks"),
     "bool for an int": ({"n_starts = 16": "n_starts = true"}, "", "design.n_starts"),
+    "single method": ({'methods = ["slsqp"]': 'method = "cobyla"'}, "", "design.method"),
 }
 
 

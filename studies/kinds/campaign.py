@@ -83,7 +83,12 @@ class CampaignDesign(CampaignSettings):
     start_from: list[str] = Field(default_factory=list, description="named designs of each model used as starts")
     points: list[dict[str, float]] = Field(default_factory=list, description="explicit starts {variable: value}")
     checks: list[str] = Field(default_factory=lambda: ["spectral_abscissa"], description="checks of each optimum")
-    method: Literal["slsqp", "cobyla", "slp"] = "slsqp"  # unused by this kind: see methods
+    method: Literal["slsqp", "cobyla", "slp"] = "slsqp"  # set per campaign from `methods`, never by the config
+
+    @field_validator("method")  # runs only for a value written in the config (defaults are not validated)
+    @classmethod
+    def _no_single_method(cls, v: str) -> str:
+        raise ValueError(f"this kind runs every entry of `methods`; write methods = [{v!r}] instead")
 
     @field_validator("methods", "objectives")
     @classmethod
