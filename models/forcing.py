@@ -244,3 +244,54 @@ def as_forcing(F: ForcingLike, n: int, field: str = "F") -> Forcing:
     if not np.all(np.isfinite(probe)):
         raise ValueError(f"{field}: F(1.0) is not finite ({probe})")
     return forcing
+
+
+class DistanceForcing:
+    """Inputs at fixed distances behind a leading point: ``F(Ω; S) = Σ_i a_i(Ω) e^{−iΩ d_i/S}``.
+
+    A vehicle running at speed S over a profile meets it at an axle d_i metres behind the leading
+    axle d_i/S seconds later (thesis (4.63)–(4.66)), so the delays of a vehicle's forcing depend on
+    the speed while the amplitudes ``a_i(Ω) = Σ_j (iΩ)^j A_ij`` do not.  :meth:`at_speed` gives the
+    :class:`Forcing` with its delays declared, which is what a parametric family with a speed term
+    (:class:`~railopt.models.parametric.ParametricSystem`) evaluates at each speed.
+
+    Parameters
+    ----------
+    terms : iterable of (coefficients, distance_m)
+        ``coefficients`` (p+1, n) (or (n,)) of powers of iΩ; ``distance_m`` ≥ 0 behind the leading point.
+    """
+
+    def __init__(self, terms: Iterable[tuple[np.ndarray, float]]) -> None:
+        built = []
+        for i, item in enumerate(terms):
+            try:
+                coefficients, distance = item
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"terms[{i}]: must be a pair (coefficients, distance_m), got {item!r}") from exc
+            term = _term(coefficients, distance, None if not built else built[0][0].shape[1], f"terms[{i}]")
+            built.append((term.coefficients, term.delay))  # the delay slot holds the distance (m) here
+        if not built:
+            raise ValueError("terms: at least one (coefficients, distance_m) term is needed")
+        self.terms = tuple(built)
+
+    @property
+    def n(self) -> int:
+        return self.terms[0][0].shape[1]
+
+    def at_speed(self, speed: float) -> Forcing:
+        """The forcing at forward speed ``speed`` (m/s): delays ``d_i / S`` declared."""
+        return Forcing(terms=[DelayedTerm(d / speed, coefficients=c) for c, d in self.terms])
+
+    def __repr__(self) -> str:
+        far = max(d for _, d in self.terms)
+        return f"DistanceForcing({len(self.terms)} term(s), up to {far:.6g} m behind)"
+
+
+def at_speed(forcing: Forcing | DistanceForcing | None, speed: float | None) -> Forcing | None:
+    """``forcing`` resolved at a speed: a :class:`DistanceForcing` needs one (m/s), a :class:`Forcing` is kept."""
+    if isinstance(forcing, DistanceForcing):
+        if speed is None:
+            raise ValueError("speed: this system's inputs are at distances along the track; give a forward speed "
+                             "(m/s)")
+        return forcing.at_speed(speed)
+    return forcing

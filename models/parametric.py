@@ -1,19 +1,19 @@
-"""Systems whose M, C, K, F are affine in a parameter vector, with analytic gradients of f_k.
+"""The one parametric system family: M, C, K and F affine in parameters, with a speed term.
 
-Suspension rates enter the equations of motion linearly, so a model is assembled once as
-``M(p) = M0 + Σ p_i M_i`` (likewise C, K and the forcing F(Ω)); a new parameter vector then costs
-no re-assembly.  :meth:`ParametricSystem.maxima_jacobians` differentiates the response maxima of
-(4.71)-(4.73) of any of the named outputs, sharing one eigen-decomposition:
+Suspension rates enter the equations of motion linearly and creep damping scales as 1/S, so a
+model is assembled once as
 
-- thesis method: ``f_j = |H(Ω_j(p), p)|`` with Ω_j the clipped ω_dj, so
-  ``df_j/dp = ∂|H|/∂p + ∂|H|/∂Ω · dω_dj/dp`` (the second term only while ω_dj is inside the band);
-  ``dω_dj/dp`` is the eigenvalue derivative ``ds_k = W_k G_p V_k`` of the state matrix (4.53)
-  with the left (rows of W = V⁻¹) and right (columns of V) eigenvectors;
-- exact method: f_j is a maximum over Ω, so by the envelope theorem ``df_j/dp = ∂|H|/∂p`` at the
-  maximiser (plus the motion of a cell boundary when the maximum sits on one).
+    M(p)    = M0 + Σ p_i M_i
+    C(p, S) = C0 + Σ p_i C_i + C_speed / S
+    K(p)    = K0 + Σ p_i K_i
+    F(p, S) = F0(S) + Σ p_i F_i(S) + F_speed(S) / S
 
-``∂H/∂p_i = (iΩ)^q wᵀ(F_i − Z_i X)`` with the adjoint ``Zᵀw = c`` (one extra solve per frequency,
-all outputs at once).
+(thesis (4.51)–(4.53) and (4.60)–(4.70); the F terms of a vehicle are its axle inputs at distances
+d_i, so their delays d_i/S depend on the speed: :class:`~railopt.models.forcing.DistanceForcing`).
+``family.at(p, speed=S)`` returns the :class:`~railopt.models.system.LinearSystem` — the only place
+in railopt where K and C are summed (:func:`affine`) — with a :class:`~railopt.models.system.Tangent`
+attached, so gradients (:mod:`railopt.models.sensitivity`) and stability
+(:mod:`railopt.models.stability`) take the system or the family alone.
 """
 
 from __future__ import annotations
@@ -23,41 +23,77 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from railopt.models.forcing import Forcing, ForcingLike, as_forcing
-from railopt.models.linear_system import LinearSystem, mode_order
-from railopt.models.response_maxima import ResponseMaxima, all_response_maxima, validate_band
-from railopt.models.validation import real_array
+from railopt.models.forcing import DistanceForcing, Forcing, ForcingLike, as_forcing, at_speed
+from railopt.models.system import LinearSystem, Output, Tangent
+from railopt.models.validation import number, real_array
+
+FamilyForcing = ForcingLike | DistanceForcing
 
 
 @dataclass(frozen=True)
 class ParameterPart:
-    """The matrices multiplying one parameter: ``M_i, C_i, K_i`` (n, n) and forcing ``F_i(Ω)``."""
+    """The matrices multiplying one parameter: ``M_i, C_i, K_i`` (n, n) and forcing ``F_i(Ω)``
+    (a :class:`Forcing`, an (n,) array, a callable, or a :class:`DistanceForcing` for inputs at distances)."""
 
     M: np.ndarray | None = None
     C: np.ndarray | None = None
     K: np.ndarray | None = None
-    F: ForcingLike | None = None
+    F: FamilyForcing | None = None
+
+
+def affine(base: np.ndarray, parts: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``base + Σ_i p_i parts[i]``: the one place railopt sums parameter-weighted matrices.
+
+    ``base`` (…), ``parts`` (P, …), ``p`` (P,).  Used for M, C, K of every family member and for the
+    input matrices of vehicle views.
+    """
+    acc = np.zeros(np.shape(base))
+    for pi, part in zip(p, parts, strict=True):  # in parameter order: exact cancellations stay exact
+        if pi != 0.0:
+            acc += pi * part
+    return base + acc
+
+
+def _family_forcing(F: FamilyForcing | None, n: int, field: str) -> Forcing | DistanceForcing | None:
+    if F is None or isinstance(F, DistanceForcing):
+        if isinstance(F, DistanceForcing) and F.n != n:
+            raise ValueError(f"{field}: terms must have n = {n} entries, got {F.n}")
+        return F
+    return as_forcing(F, n, field)
 
 
 class ParametricSystem:
-    """``M(p) = M0 + Σ p_i M_i`` (and C, K, F alike) with named outputs.
+    """A family of linear systems affine in parameters p, with an optional forward-speed term.
 
     Parameters
     ----------
     M0, C0, K0 : (n, n) array_like
         Constant parts (SI).
-    F0 : (n,) array_like, callable or Forcing
-        Constant part of the forcing amplitude.
+    F0 : (n,) array_like, callable, Forcing or DistanceForcing, optional
+        Constant part of the forcing amplitude (zero when omitted).
     output : (n,) array_like, optional
-        One output row c (with ``response``); or give ``outputs``.
+        One output row c (with ``response``); or give ``outputs`` (or neither: eigen-analysis only).
     parts : mapping name -> ParameterPart
         Parameter-weighted parts, in parameter order.
     response : str
         "displacement", "velocity" or "acceleration" (of ``output``).
     names : sequence of str, optional
         Coordinate names.
-    outputs : mapping name -> row, (row, quantity) or Output, optional
-        Several named outputs sharing every eigen-decomposition.
+    outputs : mapping name -> row, (row, quantity), (row, quantity, feedthrough) or Output, optional
+        Named outputs sharing every eigen-decomposition; a feedthrough may be a DistanceForcing.
+    C_speed : (n, n) array_like, optional
+        The speed term of the damping, C_speed / S (N·s: creep damping times speed).
+    F_speed : DistanceForcing or Forcing, optional
+        The speed term of the forcing, F_speed / S (creep forces of the rail inputs).
+    values : (P,) array_like or mapping name -> value, optional
+        The family's own parameter values (a vehicle file's suspension), used when ``at`` gets no p.
+    speed : float, optional
+        The family's own forward speed (m/s), used when ``at`` gets no speed.
+
+    Raises
+    ------
+    ValueError
+        Shapes, non-finite entries or unknown names, naming the field.
     """
 
     def __init__(
@@ -65,28 +101,48 @@ class ParametricSystem:
         M0: np.ndarray,
         C0: np.ndarray,
         K0: np.ndarray,
-        F0: ForcingLike,
+        F0: FamilyForcing | None = None,
         output: np.ndarray | None = None,
         parts: Mapping[str, ParameterPart] | None = None,
         response: str = "displacement",
         names: Sequence[str] | None = None,
         outputs: Mapping[str, object] | None = None,
+        C_speed: np.ndarray | None = None,
+        F_speed: FamilyForcing | None = None,
+        values: Sequence[float] | Mapping[str, float] | None = None,
+        speed: float | None = None,
     ) -> None:
-        self._base = LinearSystem(M0, C0, K0, F0, output, response=response, names=names, outputs=outputs)
-        parts = dict(parts or {})
+        specs = dict(outputs or {})
+        feeds = {}
+        for k, v in specs.items():  # distance feedthroughs are resolved per speed
+            if isinstance(v, tuple) and len(v) == 3 and isinstance(v[2], DistanceForcing):
+                feeds[str(k)] = v[2]
+                specs[k] = v[:2]
+        self._base = LinearSystem(M0, C0, K0, None, output, response=response, names=names,
+                                  outputs=specs if outputs is not None else None)
         n = self._base.n
+        self._F0 = _family_forcing(F0, n, "F0")
+        self._distance_feeds = feeds
+        parts = dict(parts or {})
         self.parameters = tuple(parts)
-        self._M = np.zeros((len(parts), n, n))
-        self._C = np.zeros((len(parts), n, n))
-        self._K = np.zeros((len(parts), n, n))
-        self._F: list[Forcing | None] = []
+        P = len(parts)
+        self._M = np.zeros((P, n, n))
+        self._C = np.zeros((P, n, n))
+        self._K = np.zeros((P, n, n))
+        self._F: list[Forcing | DistanceForcing | None] = []
         for i, (name, part) in enumerate(parts.items()):
             for attr, store in (("M", self._M), ("C", self._C), ("K", self._K)):
                 a = getattr(part, attr)
                 if a is not None:
                     store[i] = real_array(f"parts[{name!r}].{attr}", a, shape=(n, n))
-            self._F.append(None if part.F is None else as_forcing(part.F, n, f"parts[{name!r}].F"))
+            self._F.append(_family_forcing(part.F, n, f"parts[{name!r}].F"))
+        self._C_speed = None if C_speed is None else real_array("C_speed", C_speed, shape=(n, n))
+        self._F_speed = _family_forcing(F_speed, n, "F_speed")
+        self.values = None if values is None else self._check(self._vector(values))
+        self.speed = None if speed is None else number("speed", speed, positive=True)
+        self._at_speed_cache: dict[float | None, tuple] = {}
 
+    # ------------------------------------------------------------------ description
     @property
     def n(self) -> int:
         return self._base.n
@@ -99,131 +155,153 @@ class ParametricSystem:
     def names(self) -> tuple[str, ...]:
         return self._base.names
 
+    @property
+    def has_speed(self) -> bool:
+        """True when C or F depend on the forward speed (a speed must be given to :meth:`at`)."""
+        return (self._C_speed is not None or self._F_speed is not None
+                or any(isinstance(f, DistanceForcing) for f in [self._F0, *self._F, *self._distance_feeds.values()]))
+
     def __repr__(self) -> str:
+        speed = "" if not self.has_speed else ", speed term"
+        if self.speed is not None:
+            speed += f", S={self.speed:g} m/s"
         return (f"ParametricSystem(n={self.n}, parameters={list(self.parameters)}, "
-                f"outputs={list(self.output_names)})")
+                f"outputs={list(self.output_names)}{speed})")
+
+    def _vector(self, values: Sequence[float] | Mapping[str, float]) -> np.ndarray:
+        if isinstance(values, Mapping):
+            unknown = sorted(set(values) - set(self.parameters))
+            if unknown:
+                raise ValueError(f"values: unknown parameters {unknown}; parameters are {list(self.parameters)}")
+            missing = [k for k in self.parameters if k not in values]
+            if missing:
+                raise ValueError(f"values: missing parameters {missing}")
+            return np.array([number(k, values[k]) for k in self.parameters])
+        return np.asarray(values)
 
     def _check(self, p: Sequence[float]) -> np.ndarray:
         p = np.asarray(p)
         if p.shape != (len(self.parameters),):
             raise ValueError(f"p: expected {len(self.parameters)} parameters {self.parameters}, got shape {p.shape}")
-        if np.iscomplexobj(p):
-            raise ValueError("p: parameters must be real")
+        if p.dtype == object or np.iscomplexobj(p) or p.dtype.kind in "USb":
+            raise ValueError("p: parameters must be real numbers")
         p = p.astype(float)
         if not np.all(np.isfinite(p)):
             bad = [self.parameters[i] for i in np.flatnonzero(~np.isfinite(p))]
             raise ValueError(f"p: non-finite value for {bad}")
         return p
 
-    def _forcing(self, p: np.ndarray) -> Forcing:
-        terms = [(pi, f) for pi, f in zip(p, self._F, strict=True) if f is not None and pi != 0.0]
-        if not terms:
-            return self._base.forcing
-        return Forcing.combine([(1.0, self._base.forcing), *terms])
+    def with_values(self, values: Sequence[float] | Mapping[str, float], speed: float | None = None
+                    ) -> ParametricSystem:
+        """The same family with other default parameter values (and speed); nothing is re-assembled."""
+        new = object.__new__(ParametricSystem)
+        new.__dict__.update(self.__dict__)
+        new.values = self._check(self._vector(values))
+        if speed is not None:
+            new.speed = number("speed", speed, positive=True)
+        return new
 
-    def at(self, p: Sequence[float]) -> LinearSystem:
-        """The :class:`LinearSystem` for parameter vector ``p`` (no re-assembly)."""
-        p = self._check(p)
+    # ------------------------------------------------------------------ members
+    def _resolve_speed(self, speed: float | None) -> float | None:
+        if speed is None:
+            speed = self.speed
+        if speed is None:
+            if self.has_speed:
+                raise ValueError("speed: this family has a speed term; give a forward speed S (m/s)")
+            return None
+        return number("speed", speed, positive=True)
+
+    def _speed_parts(self, speed: float | None) -> tuple:
+        """Forcings and outputs resolved at ``speed`` (cached: a campaign evaluates many p at one speed)."""
+        if speed not in self._at_speed_cache:
+            F0 = at_speed(self._F0, speed)
+            Fs = at_speed(self._F_speed, speed)
+            Fp = [at_speed(f, speed) for f in self._F]
+            outputs = dict(self._base.outputs)
+            for k, feed in self._distance_feeds.items():
+                o = outputs[k]
+                outputs[k] = Output(o.row, o.quantity, feed.at_speed(speed))
+            if len(self._at_speed_cache) > 64:
+                self._at_speed_cache.clear()
+            self._at_speed_cache[speed] = (F0, Fs, Fp, outputs)
+        return self._at_speed_cache[speed]
+
+    def _forcing(self, p: np.ndarray, speed: float | None, F0, Fs, Fp) -> Forcing:
+        weighted = [(1.0, F0)] if F0 is not None else []
+        if Fs is not None:
+            weighted.append((1.0 / speed, Fs))
+        weighted += [(pi, f) for pi, f in zip(p, Fp, strict=True) if f is not None and pi != 0.0]
+        if len(weighted) == 1 and weighted[0][0] == 1.0:
+            return weighted[0][1]
+        if not weighted:
+            return as_forcing(np.zeros(self.n), self.n)
+        return Forcing.combine(weighted)
+
+    def at(self, p: Sequence[float] | Mapping[str, float] | None = None, speed: float | None = None) -> LinearSystem:
+        """The :class:`LinearSystem` for parameters ``p`` at forward speed ``speed`` (no re-assembly).
+
+        ``p`` (P,) or a mapping name → value; omitted: the family's own :attr:`values`.  ``speed`` in
+        m/s; omitted: the family's own :attr:`speed` (required when the family has a speed term).
+        """
+        if p is None:
+            if self.values is None:
+                raise ValueError("p: this family has no default values; give the parameter vector p")
+            p = self.values
+        else:
+            p = self._check(self._vector(p))
+        speed = self._resolve_speed(speed)
         b = self._base
-        n = b.n
-        return LinearSystem._trusted(
-            b.M + (p @ self._M.reshape(len(p), -1)).reshape(n, n),
-            b.C + (p @ self._C.reshape(len(p), -1)).reshape(n, n),
-            b.K + (p @ self._K.reshape(len(p), -1)).reshape(n, n),
-            self._forcing(p),
-            b.outputs,
-            b.names,
-        )
+        C = affine(b.C, self._C, p)
+        dC_dspeed = None
+        if self._C_speed is not None:
+            C = C + self._C_speed / speed
+            dC_dspeed = -self._C_speed / speed**2
+        F0, Fs, Fp, outputs = self._speed_parts(speed)
+        tangent = Tangent(self.parameters, p, self._M, self._C, self._K, tuple(Fp), speed, dC_dspeed,
+                          self._speed_derivative(p, speed) if speed is not None else None)
+        return LinearSystem._trusted(affine(b.M, self._M, p), C, affine(b.K, self._K, p),
+                                     self._forcing(p, speed, F0, Fs, Fp), outputs, b.names, tangent)
 
+    def _speed_derivative(self, p: np.ndarray, speed: float):
+        """``Ω -> ∂F/∂S`` at (p, S): the delays d/S and the F_speed/S term of every distance forcing."""
+        terms = [(1.0, self._F0)] + [(pi, f) for pi, f in zip(p, self._F, strict=True) if pi != 0.0]
+        distance = [(w, f) for w, f in terms if isinstance(f, DistanceForcing)]
+        Fs = self._F_speed
+        if not distance and Fs is None:
+            return None
+
+        def dF(omega: float) -> np.ndarray:
+            out = np.zeros(self.n, dtype=complex)
+            for w, f in distance:  # ∂/∂S e^{−iΩd/S} = (iΩd/S²) e^{−iΩd/S}
+                for c, d in f.terms:
+                    a = (1j * omega) ** np.arange(c.shape[0]) @ c
+                    out += w * a * (1j * omega * d / speed**2) * np.exp(-1j * omega * d / speed)
+            if Fs is not None:
+                value = at_speed(Fs, speed).value(omega)
+                out -= value / speed**2
+                if isinstance(Fs, DistanceForcing):
+                    for c, d in Fs.terms:
+                        a = (1j * omega) ** np.arange(c.shape[0]) @ c
+                        out += a * (1j * omega * d / speed**2) * np.exp(-1j * omega * d / speed) / speed
+            return out
+
+        return dF
+
+    # ------------------------------------------------------------------ thin delegates
     def response_maxima(self, p: Sequence[float], band: tuple[float, float], exact: bool = False,
-                        output: str | None = None) -> ResponseMaxima:
-        """f_k(p) of (4.71)-(4.73); see :func:`railopt.models.response_maxima.response_maxima`."""
-        return self.at(p).response_maxima(band, exact=exact, output=output)
+                        output: str | None = None, speed: float | None = None):
+        """f_k(p) of (4.71)-(4.73) over ``band`` (rad/s); see :func:`railopt.models.response_maxima.response_maxima`."""
+        return self.at(p, speed).response_maxima(band, exact=exact, output=output)
 
-    # ------------------------------------------------------------------ gradients
-    def damped_frequency_jacobian(self, p: Sequence[float]) -> np.ndarray:
-        """``dω_dj/dp_i`` (n, P), from first-order eigenvalue perturbation of G (4.53)."""
-        return self._dwd(self.at(p))
+    def response_maxima_jacobian(self, p: Sequence[float], band: tuple[float, float], exact: bool = False,
+                                 output: str | None = None, speed: float | None = None):
+        """f_k(p) and df_k/dp (n+2, P); see :func:`railopt.models.sensitivity.response_maxima_jacobian`."""
+        from railopt.models.sensitivity import response_maxima_jacobian
 
-    def _dwd(self, sys: LinearSystem) -> np.ndarray:
-        m = sys.modal()
-        idx = mode_order(m.s)[1::2]
-        n = sys.n
-        AB = np.linalg.solve(sys.M, np.hstack([sys.K, sys.C]))  # [M⁻¹K, M⁻¹C]
-        out = np.zeros((len(idx), len(self.parameters)))
-        for i in range(len(self.parameters)):
-            # d(M⁻¹K)/dp = M⁻¹(K_p − M_p M⁻¹K), likewise for C; only the lower block row of G moves
-            dAB = -np.linalg.solve(sys.M, np.hstack([self._K[i], self._C[i]]) - self._M[i] @ AB)
-            ds = np.einsum("kj,jk->k", m.W[idx][:, n:], dAB @ m.V[:, idx])
-            out[:, i] = np.where(m.s[idx].imag == 0.0, 0.0, np.sign(m.s[idx].imag) * ds.imag)
-        return out
+        return response_maxima_jacobian(self.at(p, speed), band, exact=exact, output=output)
 
-    def _partials(self, sys: LinearSystem, omega: float, cols: list[int]) -> tuple[np.ndarray, ...]:
-        """H (m,), ∂H/∂p (m, P), ∂H/∂Ω (m,) at one frequency for the output columns ``cols``."""
-        outs = [list(sys.outputs.values())[c] for c in cols]
-        rows = np.array([o.row for o in outs], dtype=complex)
-        q = np.array([o.order for o in outs])
-        Z = sys.impedance(omega)
-        F = sys.forcing_at(omega)
-        X = np.linalg.solve(Z, F)
-        w = np.linalg.solve(Z.T, rows.T).T  # (m, n) adjoints: Zᵀ w = c
-        gain = (1j * omega) ** q
-        d = np.array([o.feedthrough.value(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])
-        dd = np.array([o.feedthrough.derivative(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])
-        H = gain * (w @ F + d)
-        rhs = np.zeros((self.n, len(self.parameters)), dtype=complex)
-        for i in range(len(self.parameters)):
-            Zi = self._K[i] - omega**2 * self._M[i] + 1j * omega * self._C[i]
-            Fi = self._F[i].value(omega) if self._F[i] is not None else 0.0
-            rhs[:, i] = Fi - Zi @ X
-        dH = gain[:, None] * (w @ rhs)
-        dZ = -2 * omega * sys.M + 1j * sys.C
-        dgain = np.where(q > 0, q * 1j * (1j * omega) ** np.maximum(q - 1, 0), 0.0)
-        dHw = dgain * (w @ F + d) + gain * (w @ (sys.forcing.derivative(omega) - dZ @ X) + dd)
-        return H, dH, dHw
+    def damped_frequency_jacobian(self, p: Sequence[float], speed: float | None = None) -> np.ndarray:
+        """dω_dj/dp (n, P); see :func:`railopt.models.sensitivity.damped_frequency_jacobian`."""
+        from railopt.models.sensitivity import damped_frequency_jacobian
 
-    def maxima_jacobians(self, sys: LinearSystem, band: tuple[float, float], exact: bool = False,
-                         outputs: Sequence[str] | None = None) -> dict[str, tuple[ResponseMaxima, np.ndarray]]:
-        """f_k and their analytic Jacobians ``df_k/dp_i`` (n+2, P) for several outputs of
-        ``sys = self.at(p)``, sharing its eigen-decomposition.  Entries with f_k = inf (zero
-        damping, singular Z) get a zero gradient row."""
-        lo, hi = validate_band(band)
-        names = list(sys.output_names if outputs is None else outputs)
-        maxima = all_response_maxima(sys, (lo, hi), exact=exact, outputs=names)
-        n = sys.n
-        dwd = self._dwd(sys)
-        wd = sys.damped_frequencies()
-        inside = (wd > lo) & (wd < hi)
-        dclip = np.where(inside[:, None], dwd, 0.0)
-        result = {}
-        for name in names:
-            rm = maxima[name]
-            col = sys.output_index(name)
-            dOmega = np.zeros((n + 2, len(self.parameters)))
-            if exact:
-                clipped = np.clip(wd, lo, hi)
-                bounds = np.concatenate([[lo], 0.5 * (clipped[1:] + clipped[:-1]), [hi]])
-                dbounds = np.zeros((n + 1, len(self.parameters)))
-                dbounds[1:-1] = 0.5 * (dclip[1:] + dclip[:-1])
-                for j in range(n):
-                    for b in (j, j + 1):
-                        if abs(rm.frequencies[j] - bounds[b]) <= 1e-9 * max(hi, 1.0):
-                            dOmega[j] = dbounds[b]
-            else:
-                dOmega[:n] = dclip
-            J = np.zeros((n + 2, len(self.parameters)))
-            for k, omega in enumerate(rm.frequencies):
-                if not np.isfinite(rm.values[k]) or rm.values[k] == 0.0:
-                    continue
-                H, dH, dHw = self._partials(sys, float(omega), [col])
-                J[k] = (np.real(np.conj(H[0]) * dH[0]) + np.real(np.conj(H[0]) * dHw[0]) * dOmega[k]) / abs(H[0])
-            result[name] = (rm, J)
-        return result
-
-    def response_maxima_jacobian(
-        self, p: Sequence[float], band: tuple[float, float], exact: bool = False, output: str | None = None
-    ) -> tuple[ResponseMaxima, np.ndarray]:
-        """f_k(p) of one output and its analytic Jacobian ``df_k/dp_i``, shape (n+2, P)."""
-        sys = self.at(p)
-        name = sys.output_names[sys.output_index(output)]
-        return self.maxima_jacobians(sys, band, exact=exact, outputs=[name])[name]
+        return damped_frequency_jacobian(self.at(p, speed))

@@ -21,40 +21,11 @@ from __future__ import annotations
 
 import cmath
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from railopt.models.forcing import Forcing
-from railopt.records import ArrayRecord
-
-CONDITION_LIMIT = 1e8  # cond₁(V) above which the pole–residue form is not used (errors ≳ 1e-8)
-
-
-@dataclass(frozen=True, eq=False, repr=False)
-class Modal(ArrayRecord):
-    """Eigen-decomposition of the state matrix G (4.53): roots s (2n,), right eigenvectors V
-    (columns) and left ones W = V⁻¹ (rows, so W V = I); ``condition`` = ‖V‖₁‖W‖₁ (inf when V
-    is singular)."""
-
-    s: np.ndarray
-    V: np.ndarray
-    W: np.ndarray
-    condition: float
-
-
-def modal(G: np.ndarray) -> Modal:
-    """Right and left eigenvectors of G with the normalisation W V = I."""
-    s, V = np.linalg.eig(G)
-    try:
-        W = np.linalg.solve(V, np.eye(V.shape[0]))
-        condition = float(np.linalg.norm(V, 1) * np.linalg.norm(W, 1))
-    except np.linalg.LinAlgError:
-        W = np.full_like(V, np.nan)
-        condition = float("inf")
-    if not np.isfinite(condition):
-        condition = float("inf")
-    return Modal(s, V, W, condition)
+from railopt.models.modal import Modal
 
 
 class PoleResidue:

@@ -31,22 +31,22 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from railopt.models.modal import UNDAMPED_ROOT
 from railopt.models.peak_search import cell_maxima
 from railopt.models.validation import band as validate_band
 from railopt.records import ArrayRecord
 
 if TYPE_CHECKING:  # pragma: no cover
-    from railopt.models.linear_system import LinearSystem
+    from railopt.models.system import LinearSystem
 
 GRID_FACTOR = 0.25  # max grid step / distance to nearest pole
 CERTIFIED_RATIO = GRID_FACTOR / (1 - GRID_FACTOR)
 POLE_STEP = 0.2  # step in u of the per-pole grids Ω = ω_k + σ_k sinh(u); keeps step/dist ≤ 0.222
 MIN_CELL_SAMPLES = 8
 MAX_GRID_POINTS = 200_000
-UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
 CONSISTENCY_RTOL = 1e-6  # pole–residue vs direct value at a refined maximum; beyond it, redo by direct solves
 
-__all__ = ["ResponseMaxima", "all_response_maxima", "band_grid", "response_maxima", "validate_band"]
+__all__ = ["ResponseMaxima", "all_response_maxima", "band_grid", "peak", "response_maxima", "validate_band"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -144,6 +144,12 @@ def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool
     """
     name = system.output_names[system.output_index(output)]
     return all_response_maxima(system, band, exact=exact, outputs=[name])[name]
+
+
+def peak(system: LinearSystem, band: tuple[float, float], exact: bool = True, output: str | None = None) -> float:
+    """``U = max_k f_k`` (4.74) of one output over ``band`` (rad/s); ``exact=True`` gives the certified
+    band maximum."""
+    return response_maxima(system, band, exact=exact, output=output).value
 
 
 def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool = False,

@@ -1,23 +1,127 @@
-"""Lateral stability against forward speed: root locus and critical speed (thesis §4.3.1, (4.51)–(4.59)).
+"""Stability against forward speed: spectral abscissa, root locus, critical speed, least damping
+(thesis §4.3.1, (4.51)–(4.59)).
 
-The creep damping scales as 1/S, so one model assembly serves every speed:
-``C(S) = C_const + C_creep / S`` and each speed costs one eigen-solve of the state matrix G (4.53).
-The critical speed is the lowest S where the spectral abscissa ``a(S) = max_j Re s_j`` crosses zero;
-it is bracketed on a short grid and then located by Brent's method on ``a(S)`` to ``tol`` m/s.
+Every analysis takes a *model*: anything with a method ``at(speed=S)`` (or ``at(p, speed=S)``)
+returning a :class:`~railopt.models.system.LinearSystem` — a vehicle view, a
+:class:`~railopt.models.parametric.ParametricSystem` with its speed term, a small user class.  A
+vehicle definition (anything with a ``lateral(track)`` view) is accepted with ``track=``.  The
+creep damping scales as 1/S, so one assembly serves every speed and each speed costs one
+eigen-solve of the state matrix G (4.53).  The critical speed is the lowest S where the spectral
+abscissa ``a(S) = max_j Re s_j`` crosses zero; it is bracketed on a short grid and located by
+Brent's method on ``a(S)`` to ``tol`` m/s.  This module never imports the vehicle package.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import numbers
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
-from railopt.models.vehicle.model import VehicleModel, check_speed
-from railopt.models.vehicle.vehicle import Vehicle
+from railopt.models.system import LinearSystem
+from railopt.models.validation import number
+from railopt.records import ArrayRecord
+
+NEUTRAL_ROOT = 1e-8  # |s| ≤ NEUTRAL_ROOT · max|s| counts as s = 0 (a free rigid-body motion, not instability)
+
+
+def abscissa(s: np.ndarray) -> float:
+    """max Re s over the roots that are not neutral rigid-body roots (|s| ≤ 1e-8 max|s| counts as s = 0)."""
+    scale = float(np.max(np.abs(s))) if s.size else 0.0
+    live = s[np.abs(s) > NEUTRAL_ROOT * scale]
+    return float(np.max(live.real)) if live.size else 0.0
+
+
+def _speed_function(model: object, track: str | None) -> Callable[[float], LinearSystem]:
+    """``S -> LinearSystem`` for a model with ``at(speed=S)``, or a vehicle with ``lateral(track)``."""
+    if isinstance(model, LinearSystem):
+        raise ValueError("model: a LinearSystem has one speed; give a model with at(speed=S) (a vehicle view or a "
+                         "ParametricSystem with a speed term)")
+    if track is not None or (not hasattr(model, "at") and hasattr(model, "lateral")):
+        if not hasattr(model, "lateral"):
+            raise ValueError("track: only a vehicle (with a lateral(track) view) takes track=")
+        model = model.lateral(track=track or "rigid")
+    if not callable(getattr(model, "at", None)):
+        raise ValueError(f"model: needs a method at(speed=S) returning a LinearSystem, got {type(model).__name__}")
+    return lambda S: model.at(speed=S)
+
+
+class _Counted:
+    """``S -> system`` with a count of eigen-solves."""
+
+    def __init__(self, model: object, track: str | None) -> None:
+        self.at = _speed_function(model, track)
+        self.solves = 0
+
+    def roots(self, speed: float) -> np.ndarray:
+        self.solves += 1
+        return self.at(speed).eigenvalues()
+
+    def __call__(self, speed: float) -> float:
+        return abscissa(self.roots(speed))
+
+
+def spectral_abscissa(system: LinearSystem | object, speed: float | None = None, track: str | None = None) -> float:
+    """Largest real part of the roots, 1/s (neutral rigid-body roots ignored): a system, or a model at ``speed``
+    (its own speed when omitted)."""
+    if not isinstance(system, LinearSystem):
+        system = _speed_function(system, track)(speed)
+    return abscissa(system.eigenvalues())
+
+
+def _speeds(speeds: object, name: str = "speeds") -> np.ndarray:
+    try:
+        values = [number(f"{name}[{i}]", s, positive=True) for i, s in enumerate(np.atleast_1d(speeds))]
+    except ValueError as exc:
+        raise ValueError(f"{exc} (forward speeds in m/s)") from None
+    if not values:
+        raise ValueError(f"{name}: give at least one forward speed (m/s)")
+    return np.array(values)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class RootLocus(ArrayRecord):
+    """Roots against forward speed (Fig 4.4).
+
+    Attributes
+    ----------
+    speeds : (N,) ndarray
+        Forward speeds, m/s.
+    roots : (N, 2n) ndarray
+        Roots at each speed (1/s), in railopt's mode order (ascending |Im s|, then Re s).
+    """
+
+    speeds: np.ndarray
+    roots: np.ndarray
+
+    def to_pandas(self) -> pd.DataFrame:
+        """One row per root with Im s ≥ 0: ``speed`` (m/s), ``mode`` (rank by frequency at that speed), ``real``,
+        ``imag`` (1/s, rad/s), ``damping_ratio`` (−Re s/|s|), ``frequency_hz``."""
+        rows = []
+        for S, s in zip(self.speeds, self.roots, strict=True):
+            s = s[s.imag >= 0.0]
+            s = s[np.lexsort((s.real, s.imag))]
+            for j, r in enumerate(s):
+                mag = abs(r)
+                rows.append((float(S), j, r.real, r.imag, -r.real / mag if mag > 0 else 1.0, r.imag / (2.0 * math.pi)))
+        return pd.DataFrame(rows, columns=["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz"])
+
+
+def root_locus(model: object, speeds: Sequence[float], track: str | None = None) -> RootLocus:
+    """Roots of ``model`` at each forward speed (m/s), one eigen-solve each (Fig. 4.4).
+
+    Raises
+    ------
+    ValueError
+        A speed that is not a positive finite number (naming ``speeds[i]``), a model without ``at(speed=S)``.
+    """
+    S = _speeds(speeds)
+    counted = _Counted(model, track)
+    return RootLocus(S, np.array([counted.roots(float(v)) for v in S]))
 
 
 @dataclass(frozen=True)
@@ -55,85 +159,30 @@ class CriticalSpeed:
     def stable_over_range(self) -> bool:
         return math.isinf(self.speed)
 
-
-def _model(vehicle: Vehicle | VehicleModel, track: str) -> VehicleModel:
-    if isinstance(vehicle, VehicleModel):
-        return vehicle
-    return vehicle.lateral(track=track)
-
-
-class _Abscissa:
-    """a(S) = max Re s_j with a count of eigen-solves (the model's suspension fixed)."""
-
-    def __init__(self, model: VehicleModel) -> None:
-        n = model.n_dof
-        Minv = np.linalg.inv(model.M)
-        self.n = n
-        self.top = np.hstack([np.zeros((n, n)), np.eye(n)])
-        self.mk = -Minv @ model.K
-        self.mc = -Minv @ model.C_const
-        self.mcc = -Minv @ model.C_creep
-        self.names = model.coordinates
-        self.solves = 0
-
-    def roots(self, speed: float) -> tuple[np.ndarray, np.ndarray]:
-        self.solves += 1
-        G = np.vstack([self.top, np.hstack([self.mk, self.mc + self.mcc / speed])])
-        s, vec = np.linalg.eig(G)
-        return s, vec[: self.n]
-
-    def __call__(self, speed: float) -> float:
-        s, _ = self.roots(speed)
-        return abscissa(s)
+    def to_pandas(self) -> pd.DataFrame:
+        """One row: every field, the bracket as ``bracket_low``, ``bracket_high`` (m/s)."""
+        return pd.DataFrame([{"speed": self.speed, "frequency_hz": self.frequency, "mode": self.mode,
+                              "eigen_solves": self.eigen_solves, "bracket_low": self.bracket[0],
+                              "bracket_high": self.bracket[1], "unstable_at_lower_end": self.unstable_at_lower_end,
+                              "stable_over_range": self.stable_over_range, "tol": self.tol}])
 
 
-def abscissa(s: np.ndarray) -> float:
-    """max Re s over the roots that are not neutral rigid-body roots (|s| <= 1e-8 max|s| counts as s = 0)."""
-    scale = float(np.max(np.abs(s))) if s.size else 0.0
-    live = s[np.abs(s) > 1e-8 * scale]
-    return float(np.max(live.real)) if live.size else 0.0
-
-
-def spectral_abscissa(model: VehicleModel) -> float:
-    """Largest real part of the roots of ``model`` at its speed, 1/s."""
-    return abscissa(model.eigenvalues())
-
-
-def root_locus(vehicle: Vehicle | VehicleModel, track: str = "rigid", speeds: Sequence[float] = ()) -> pd.DataFrame:
-    """Roots against forward speed (Fig. 4.4).
-
-    Parameters
-    ----------
-    vehicle : Vehicle or VehicleModel
-        A vehicle (its lateral model on ``track`` is used) or a model.
-    track : {"rigid", "flexible"}
-    speeds : sequence of float
-        Forward speeds, m/s (each positive).
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per root with Im s >= 0: ``speed`` (m/s), ``mode`` (rank by frequency at that
-        speed), ``real``, ``imag`` (1/s, rad/s), ``damping_ratio`` (−Re s/|s|), ``frequency_hz``.
-    """
-    speeds = [check_speed(s) for s in speeds]
-    if not speeds:
-        raise ValueError("speeds: give at least one forward speed (m/s)")
-    ab = _Abscissa(_model(vehicle, track))
-    rows = []
-    for S in speeds:
-        s, _ = ab.roots(S)
-        s = s[s.imag >= 0.0]
-        s = s[np.lexsort((s.real, s.imag))]
-        for j, r in enumerate(s):
-            mag = abs(r)
-            rows.append((S, j, r.real, r.imag, -r.real / mag if mag > 0 else 1.0, r.imag / (2.0 * math.pi)))
-    return pd.DataFrame(rows, columns=["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz"])
+def _speed_range(speed_range: object) -> tuple[float, float]:
+    try:
+        pair = list(speed_range)  # type: ignore[call-overload]
+    except TypeError:
+        pair = None
+    if pair is None or len(pair) != 2:
+        raise ValueError(f"speed_range: must be a pair (lowest, highest) of speeds in m/s, got {speed_range!r}")
+    lo, hi = (number(f"speed_range[{i}]", v, positive=True) for i, v in enumerate(pair))
+    if not hi > lo:
+        raise ValueError(f"speed_range: inverted or empty range ({lo}, {hi}) m/s")
+    return lo, hi
 
 
 def critical_speed(
-    vehicle: Vehicle | VehicleModel,
-    track: str = "rigid",
+    model: object,
+    track: str | None = None,
     speed_range: tuple[float, float] = (1.0, 100.0),
     tol: float = 0.01,
     grid: int = 8,
@@ -149,31 +198,35 @@ def critical_speed(
 
     Parameters
     ----------
-    vehicle : Vehicle or VehicleModel
-    track : {"rigid", "flexible"}
+    model : object with ``at(speed=S)``, or a vehicle with ``track``
+        A vehicle view, a ParametricSystem with a speed term, any model returning a LinearSystem.
+    track : {"rigid", "flexible"}, optional
+        For a vehicle definition: the lateral view on this track.
     speed_range : (float, float)
         Lowest and highest forward speed, m/s.
     tol : float
         Absolute tolerance on the critical speed, m/s.
     grid : int
         Number of bracketing speeds (>= 2).
+
+    Raises
+    ------
+    ValueError
+        A bad ``speed_range``, ``tol`` or ``grid`` (naming it), or a model without ``at(speed=S)``.
     """
-    lo, hi = (check_speed(s) for s in speed_range)
-    if not hi > lo:
-        raise ValueError(f"speed_range: inverted or empty range ({lo}, {hi}) m/s")
-    if not (math.isfinite(tol) and tol > 0.0):
-        raise ValueError(f"tol: must be a positive speed (m/s), got {tol!r}")
-    if grid < 2:
-        raise ValueError(f"grid: need at least 2 speeds, got {grid}")
-    ab = _Abscissa(_model(vehicle, track))
-    found, bracket = first_crossing(ab, lo, hi, tol, grid)
+    lo, hi = _speed_range(speed_range)
+    tol = number("tol", tol, positive=True)
+    if isinstance(grid, bool) or not isinstance(grid, numbers.Integral) or grid < 2:
+        raise ValueError(f"grid: must be an integer number of bracketing speeds ≥ 2, got {grid!r}")
+    counted = _Counted(model, track)
+    found, bracket = first_crossing(counted, lo, hi, tol, int(grid))
     if found == lo and bracket == (lo, lo):
-        f, mode = _critical_root(ab, lo)
-        return CriticalSpeed(lo, f, mode, ab.solves, (lo, lo), True, tol)
+        f, mode = _critical_root(counted, lo)
+        return CriticalSpeed(lo, f, mode, counted.solves, (lo, lo), True, tol)
     if math.isinf(found):
-        return CriticalSpeed(math.inf, math.nan, "", ab.solves, bracket, False, tol)
-    f, mode = _critical_root(ab, bracket[1])
-    return CriticalSpeed(found, f, mode, ab.solves, bracket, False, tol)
+        return CriticalSpeed(math.inf, math.nan, "", counted.solves, bracket, False, tol)
+    f, mode = _critical_root(counted, bracket[1])
+    return CriticalSpeed(found, f, mode, counted.solves, bracket, False, tol)
 
 
 def first_crossing(a, lo: float, hi: float, tol: float, grid: int) -> tuple[float, tuple[float, float]]:
@@ -207,8 +260,22 @@ def _refine(a, left: float, right: float, tol: float) -> tuple[float, tuple[floa
     return float(root), (float(max(root - tol, left)), float(min(root + tol, right)))
 
 
-def _critical_root(ab: _Abscissa, speed: float) -> tuple[float, str]:
-    s, vec = ab.roots(speed)
-    real = np.where(np.abs(s) > 1e-8 * np.max(np.abs(s)), s.real, -np.inf)
+def _critical_root(counted: _Counted, speed: float) -> tuple[float, str]:
+    counted.solves += 1
+    system = counted.at(speed)
+    m = system.modal()
+    n = system.n
+    real = np.where(np.abs(m.s) > NEUTRAL_ROOT * np.max(np.abs(m.s)), m.s.real, -np.inf)
     j = int(np.argmax(real))
-    return float(abs(s[j].imag)) / (2.0 * math.pi), ab.names[int(np.argmax(np.abs(vec[:, j])))]
+    return float(abs(m.s[j].imag)) / (2.0 * math.pi), system.names[int(np.argmax(np.abs(m.V[:n, j])))]
+
+
+def least_damping(model: object, speeds: Sequence[float], track: str | None = None) -> float:
+    """Smallest damping ratio −Re s/|s| over the roots at ``speeds`` (m/s; neutral roots s ≈ 0 skipped)."""
+    counted = _Counted(model, track)
+    worst = math.inf
+    for S in _speeds(speeds):
+        s = counted.roots(float(S))
+        live = s[np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s))]
+        worst = min(worst, float(np.min(-live.real / np.abs(live))))
+    return worst

@@ -71,3 +71,22 @@ def band(value: object, name: str = "band") -> tuple[float, float]:
     if not hi > lo:
         raise ValueError(f"{name}: is empty or inverted, lower {lo} ≥ upper {hi}")
     return lo, hi
+
+
+def frequencies_rad_s(value: object, name: str = "omega") -> np.ndarray:
+    """Forcing frequencies in rad/s as a 1-D float array: numbers (not strings or booleans), finite, ≥ 0."""
+    arr = np.atleast_1d(np.asarray(value, dtype=object) if not isinstance(value, np.ndarray) else value)
+    if arr.dtype == object or arr.dtype.kind in "USb":
+        bad = [v for v in arr.ravel() if isinstance(v, bool | np.bool_ | str | bytes)
+               or not isinstance(v, Real | np.floating | np.integer)]
+        if bad or arr.dtype.kind in "USb":
+            shown = bad[0] if bad else arr.ravel()[0]
+            raise ValueError(f"{name}: frequencies must be real numbers, got {shown!r}")
+    if np.iscomplexobj(arr):
+        raise ValueError(f"{name}: frequencies must be real, got a complex array")
+    w = arr.astype(float).ravel()
+    if not np.all(np.isfinite(w)):
+        raise ValueError(f"{name}: must be finite and ≥ 0 (frequencies), got {w[~np.isfinite(w)][:3].tolist()}")
+    if np.any(w < 0):
+        raise ValueError(f"{name}: frequencies must be ≥ 0, got {w[w < 0][:3].tolist()}")
+    return w

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from railopt.models.track.units import INCH
+from railopt.models.units import INCH
 
 _UNITS = ("inch-pound", "SI")
 

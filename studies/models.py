@@ -7,14 +7,14 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from railopt.models.stability import spectral_abscissa as vehicle_abscissa
+from railopt.models.stability import spectral_abscissa
 from railopt.models.tmd import den_hartog, nishihara_asami, tmd_parameters, tmd_system
 from railopt.models.vehicle import load_vehicle
 from railopt.studies.base import StrictModel
 from railopt.studies.catalog import ModelSetup, register_model
 
 
-def spectral_abscissa(setup: ModelSetup):
+def abscissa_check(setup: ModelSetup):
     """A check: the largest real part of the roots of G (4.53), 1/s; stable when negative (4.59)."""
 
     def check(p: np.ndarray) -> tuple[float, dict[str, bool]]:
@@ -58,7 +58,7 @@ def tmd_setup(options: TMDOptions) -> ModelSetup:
         transform_variables=("tuning", "damping_ratio"),
         description=f"TMD, μ = {mu:g}, m1 = {m1:g} kg, f1 = {options.primary_frequency_hz:g} Hz",
     )
-    setup.checks["spectral_abscissa"] = spectral_abscissa(setup)
+    setup.checks["spectral_abscissa"] = abscissa_check(setup)
     return setup
 
 
@@ -79,18 +79,19 @@ def vehicle_lateral_setup(options: VehicleOptions) -> ModelSetup:
         vehicle = vehicle.with_parameters(options.parameters)
     model = vehicle.lateral(track=options.track, speed=options.speed_m_s)
     names = list(model.parts)
-    system = model.parametric(names, output=options.output)
+    system = model.family(names, outputs=[options.output or model.coordinates[0]])
     defaults = np.array([model.values[n] for n in names])
+    free = model.family(names)
 
     def speed_model(p: np.ndarray):
-        return model.with_values(dict(zip(names, p, strict=True)))
+        return free.with_values(p)
 
     setup = ModelSetup(system=system, defaults=defaults,
                        named_designs={"existing": dict(zip(names, defaults, strict=True))},
                        description=f"{vehicle.name}, lateral, {options.track} track", speed_model=speed_model)
 
     def hunting(p: np.ndarray) -> tuple[float, dict[str, bool]]:
-        value = vehicle_abscissa(speed_model(p).at_speed(options.speed_m_s))
+        value = spectral_abscissa(speed_model(p), speed=options.speed_m_s)
         return value, {"stable": value < 0}
 
     setup.checks["spectral_abscissa"] = hunting
@@ -143,18 +144,19 @@ def vehicle_forced_setup(options: VehicleForcedOptions) -> ModelSetup:
     names = list(model.parts)
     system = model.forced_parametric(irregularity, names, options.outputs, options.quantity)
     defaults = np.array([model.values[n] for n in names])
+    free = model.family(names)
 
     def speed_model(p: np.ndarray):
-        return model.with_values(dict(zip(names, p, strict=True)))
+        return free.with_values(p)
 
     setup = ModelSetup(system=system, defaults=defaults,
                        named_designs={"existing": dict(zip(names, defaults, strict=True))},
-                       description=f"{model.vehicle.name}, {options.view}, {options.track} track, "
+                       description=f"{model.name}, {options.view}, {options.track} track, "
                                    f"S = {options.speed_m_s:g} m/s, {irregularity.label}",
                        speed_model=speed_model)
 
     def stability(p: np.ndarray) -> tuple[float, dict[str, bool]]:
-        value = vehicle_abscissa(speed_model(p))  # neutral roots (free fore-aft translation) ignored
+        value = spectral_abscissa(speed_model(p))  # neutral roots (free fore-aft translation) ignored
         return value, {"stable": value < 0}
 
     setup.checks["spectral_abscissa"] = stability

@@ -15,6 +15,7 @@ import numpy as np
 
 from railopt.design import DesignVariable, MinimaxProblem
 from railopt.models import LinearSystem
+from railopt.models.sensitivity import maxima_jacobians
 from railopt.studies.catalog import ModelSetup
 
 
@@ -47,7 +48,7 @@ class _Evaluator:
         sys, dp = self.system(x)
         values, jacs = [], []
         for t in targets:
-            rm, J = self.setup.system.maxima_jacobians(sys, t.band, exact=t.exact, outputs=[t.output])[t.output]
+            rm, J = maxima_jacobians(sys, t.band, exact=t.exact, outputs=[t.output])[t.output]
             values.append(rm.values)
             jacs.append(J @ dp)
         return np.concatenate(values), np.vstack(jacs)

@@ -9,13 +9,12 @@ ratio up to the maximum operating speed — the stability check of every distinc
 
 from __future__ import annotations
 
-import math
 from typing import Literal
 
 import numpy as np
 from pydantic import Field
 
-from railopt.models.stability import critical_speed
+from railopt.models.stability import critical_speed, least_damping
 from railopt.models.vehicle import load_vehicle
 from railopt.models.vehicle.cab import INCH, MPH, CabInput, cab_lateral_model
 from railopt.studies.base import StrictModel
@@ -34,16 +33,6 @@ class CabOptions(StrictModel):
     parameters: dict[str, float] = Field(default_factory=dict, description="values overriding the vehicle file")
 
 
-def least_damping(model, speeds: np.ndarray) -> float:
-    """Smallest damping ratio −Re s/|s| over the roots at ``speeds`` (neutral roots s ≈ 0 skipped)."""
-    worst = math.inf
-    for S in speeds:
-        s = model.at_speed(float(S)).eigenvalues()
-        live = s[np.abs(s) > 1e-8 * np.max(np.abs(s))]
-        worst = min(worst, float(np.min(-live.real / np.abs(live))))
-    return worst
-
-
 @register_model("cab_lateral", CabOptions,
                 "thesis §4.3.3 cab model: body lateral/roll/yaw on the secondary suspension, trucks following a "
                 "lateral irregularity; outputs cab_acceleration (m/s²), cab_displacement, strokes")
@@ -56,12 +45,12 @@ def cab_lateral_setup(options: CabOptions) -> ModelSetup:
     names = list(cab.system.parameters)
     defaults = cab.parameters()
     aliases = {a: k for a, k in vehicle.element_aliases().items() if k in names}
-    lateral = {track: vehicle.lateral(track=track) for track in ("rigid", "flexible")}
+    lateral = {track: vehicle.lateral(track=track).family(names) for track in ("rigid", "flexible")}
     v_max = options.max_operating_speed_mph * MPH
     search = (options.critical_search_mph[0] * MPH, options.critical_search_mph[1] * MPH)
 
     def speed_model(p: np.ndarray, track: str = "rigid"):
-        return lateral[track].with_values(dict(zip(names, p, strict=True)))
+        return lateral[track].with_values(p)
 
     def hunting(p: np.ndarray) -> tuple[float, dict]:
         """min critical speed (m/s) over rigid and flexible track; flags and numbers per track."""

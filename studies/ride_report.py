@@ -155,7 +155,7 @@ def _before_after(cfg, setup, model, names, after, band, best, tag, context) -> 
                markdown_table(stab_table, digits=5), ""]
     if cfg.report.locus_speeds_m_s is not None:
         speeds = np.linspace(*cfg.report.locus_speeds_m_s, 80)
-        loci = {label: root_locus(setup.speed_model(p), speeds=speeds) for label, p in
+        loci = {label: root_locus(setup.speed_model(p), speeds).to_pandas() for label, p in
                 (("before", p_before), ("after", p_after))}
         fig = plot_root_loci_before_after(loci, f"{model}: velocity root loci before and after (rigid track)")
         fig.savefig(context.outdir / f"root_locus_before_after{tag}.png", dpi=cfg.report.dpi)

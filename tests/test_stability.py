@@ -20,7 +20,7 @@ def sd40():
 def first_unstable_speed(vehicle, track: str, lo: float, hi: float, step: float) -> float:
     """Lowest speed of a dense grid with a root in Re s > 0 (the independent reference)."""
     speeds = np.arange(lo, hi + step / 2, step)
-    rl = root_locus(vehicle, track, speeds)
+    rl = root_locus(vehicle, speeds, track=track).to_pandas()
     abscissa = rl.groupby("speed")["real"].max()
     unstable = abscissa[abscissa > 0.0]
     return float(unstable.index[0]) if len(unstable) else math.inf
@@ -56,7 +56,7 @@ def test_stable_over_range_and_unstable_at_lower_end() -> None:
 
 
 def test_root_locus_table(sd40) -> None:
-    rl = root_locus(sd40, "rigid", [10.0, 20.0])
+    rl = root_locus(sd40, [10.0, 20.0], track="rigid").to_pandas()
     assert list(rl.columns) == ["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz"]
     assert isinstance(rl, pd.DataFrame)
     one = rl[rl.speed == 10.0]
@@ -87,7 +87,7 @@ def test_non_positive_speed_in_models() -> None:
         with pytest.raises(ValueError, match="speed"):
             v.lateral(speed=bad)
         with pytest.raises(ValueError, match="speed"):
-            root_locus(v, "rigid", [bad])
+            root_locus(v, [bad], track="rigid")
     with pytest.raises(ValueError, match="speed"):
         v.lateral().C  # noqa: B018 - no speed set
 

@@ -108,7 +108,7 @@ def test_with_parameters_and_parametric(sd40) -> None:
     fast = base.with_values(dict(zip(ids, values, strict=True)))  # no re-assembly
     for attr in ("M", "C", "K"):
         assert np.allclose(getattr(fast, attr), getattr(expected, attr), rtol=1e-12, atol=1e-6)
-    ps = base.parametric(names, output="cab.lateral")
+    ps = base.family(names, outputs=["cab.lateral"])
     assert isinstance(ps, ParametricSystem)
     sys = ps.at(values)
     for attr in ("M", "C", "K"):

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from railopt.models.track.beam import Beam
-from railopt.models.track.units import INCH, LB_PER_YARD, POUND_MASS, PSI
+from railopt.models.units import INCH, LB_PER_YARD, POUND_MASS, PSI
 
 E_STEEL = 30.0e6 * PSI  # Pa
 TRACK_MODULUS = 3000.0 * PSI  # N/m² per rail

@@ -1,22 +1,25 @@
 """Vehicle models: a generic small-motion rigid-body assembler and vehicle data files.
 
-Public API: :func:`load_vehicle` → :class:`Vehicle`; ``vehicle.with_parameters({...})``,
-``vehicle.lateral(track="rigid"|"flexible", speed=S)`` / ``.vertical(...)`` → :class:`VehicleModel`
-with ``.M .C .K`` (numpy), ``.n_dof``, ``.coordinates``, ``.eigenvalues()``, ``.parametric(names)``;
-forced response to rail irregularities: ``model.frequency_response(f_hz, Irregularity(...), outputs)``,
-``model.forced_system(...)`` (``docs/forced_response.md``).
+A one-way pipeline: file (:func:`load_vehicle`) → definition (:class:`Vehicle`) → assembly
+(:func:`assemble`) → views (``vehicle.lateral(track, speed)`` / ``.vertical(...)`` / ``.full(...)`` →
+:class:`VehicleView`: one block's matrices, coordinates, inputs and constraint rows) → outputs
+(:mod:`~railopt.models.vehicle.outputs`), irregularity inputs and forced systems
+(:mod:`~railopt.models.vehicle.forced`).  ``view.family(names, input, outputs)`` is the
+:class:`~railopt.models.parametric.ParametricSystem` with its speed term that stability, forced
+response and design use (``docs/forced_response.md``).
 Schema, coordinates and conventions: ``docs/vehicle.md``.
 """
 
 from railopt.models.vehicle.assembly import Assembly, assemble
 from railopt.models.vehicle.bodies import Body
 from railopt.models.vehicle.elements import Element
+from railopt.models.vehicle.forced import forced_parametric, forced_system, frequency_response
 from railopt.models.vehicle.geometry import DOFS, LATERAL_DOFS, THESIS_SIGNS, VERTICAL_DOFS
 from railopt.models.vehicle.irregularity import Irregularity, RailInput
 from railopt.models.vehicle.loader import BUNDLED, VehicleFileError, load_vehicle, parse_vehicle
-from railopt.models.vehicle.model import VehicleModel
-from railopt.models.vehicle.response import PointOutput, forced_parametric, forced_system, frequency_response
+from railopt.models.vehicle.outputs import PointOutput
 from railopt.models.vehicle.vehicle import Vehicle
+from railopt.models.vehicle.views import VehicleModel, VehicleView
 from railopt.models.vehicle.wheelrail import Creep, WheelRail
 
 __all__ = [
@@ -35,6 +38,7 @@ __all__ = [
     "Vehicle",
     "VehicleFileError",
     "VehicleModel",
+    "VehicleView",
     "WheelRail",
     "assemble",
     "forced_parametric",

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from railopt.models.parametric import affine
 from railopt.models.vehicle.bodies import Body
 from railopt.models.vehicle.constraints import Relation, fixed, hinge, rigid_tie, transformation
 from railopt.models.vehicle.elements import GROUND, Element
@@ -60,16 +61,22 @@ class Assembly:
     T_in: np.ndarray
     independent: tuple[str, ...]
 
+    def _weighted(self, kind: str, base: np.ndarray) -> np.ndarray:
+        ids = [k for k, (kd, _) in self.parts.items() if kd == kind]
+        stack = np.array([self.parts[k][1] for k in ids]).reshape(len(ids), *base.shape)
+        return affine(base, stack, np.array([self.values[k] for k in ids]))
+
     def K(self) -> np.ndarray:
         """Full stiffness at the stored parameter values, N/m and N·m/rad."""
-        return self.K0 + sum((v * self.parts[k][1] for k, v in self.values.items() if self.parts[k][0] == "K"),
-                             np.zeros_like(self.K0))
+        return self._weighted("K", self.K0)
+
+    def C_const(self) -> np.ndarray:
+        """Speed-independent damping at the stored parameter values, N·s/m."""
+        return self._weighted("C", self.C0)
 
     def C(self, speed: float) -> np.ndarray:
-        """Full damping at forward speed ``speed`` (m/s)."""
-        C = self.C0 + self.C_creep / speed
-        return C + sum((v * self.parts[k][1] for k, v in self.values.items() if self.parts[k][0] == "C"),
-                       np.zeros_like(self.C0))
+        """Full damping at forward speed ``speed`` (m/s): ``C_const + C_creep / S``."""
+        return self.C_const() + self.C_creep / speed
 
 
 def track_body_name(wheelset: str) -> str:

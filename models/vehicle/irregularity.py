@@ -102,7 +102,7 @@ class Irregularity:
         A wavelength L (m): the thesis's sweep ("increased from zero to 8 hertz corresponding to a
         forward speed of approximately 200 mph") — f is reached by running at S = f L, so the
         creep damping and the delays change with f while the axle phases 2π d_i/L stay fixed
-        (:func:`railopt.models.vehicle.response.frequency_response` only; a LinearSystem has one speed).
+        (:func:`railopt.models.vehicle.forced.frequency_response` only; a LinearSystem has one speed).
     """
 
     kind: str = "vertical"
@@ -158,6 +158,15 @@ class Irregularity:
         u[list(inputs).index(name)] = value
         return u
 
+    def axle_inputs(self, inputs: Sequence[str], wheelsets: Sequence[tuple[str, float]],
+                    semi_gauge: float) -> list[tuple[np.ndarray, float]]:
+        """Per axle: the input vector u_i over ``inputs`` and its distance (m) behind the foremost axle
+        (the vehicle runs towards +x); wheelsets ``[(name, x_m), ...]``."""
+        if not wheelsets:
+            raise ValueError("input: the vehicle has no wheelsets to excite")
+        lead = max(x for _, x in wheelsets)
+        return [(self.axle_vector(inputs, name, semi_gauge), lead - x) for name, x in wheelsets]
+
     def rail_input(self, inputs: Sequence[str], wheelsets: Sequence[tuple[str, float]], speed: float,
                    semi_gauge: float) -> RailInput:
         """Delayed axle inputs for wheelsets ``[(name, x_m), ...]`` at forward speed ``speed`` (m/s).
@@ -165,10 +174,7 @@ class Irregularity:
         ``τ_i = (x_lead − x_i) / S`` with x_lead the foremost axle (the vehicle runs towards +x).
         """
         speed = number("speed", speed, positive=True)
-        if not wheelsets:
-            raise ValueError("input: the vehicle has no wheelsets to excite")
-        lead = max(x for _, x in wheelsets)
-        terms = tuple((self.axle_vector(inputs, name, semi_gauge), (lead - x) / speed) for name, x in wheelsets)
+        terms = tuple((u, d / speed) for u, d in self.axle_inputs(inputs, wheelsets, semi_gauge))
         return RailInput(tuple(inputs), terms, self.label)
 
 

@@ -10,16 +10,16 @@ import numpy as np
 
 from railopt.models.track.beam import Beam
 from railopt.models.track.lumped import LumpedTrack, lumped
+from railopt.models.units import GRAVITY
 from railopt.models.vehicle.assembly import TRACKS, Assembly, assemble
 from railopt.models.vehicle.bodies import Body
 from railopt.models.vehicle.constraints import check_reduced_mass
 from railopt.models.vehicle.elements import Element
 from railopt.models.vehicle.geometry import LATERAL_DOFS, VERTICAL_DOFS, point_jacobian, split
-from railopt.models.vehicle.model import VehicleModel, check_speed
 from railopt.models.vehicle.spec import ConstraintSpec, ContactSpec, Lengths, TrackSpec
+from railopt.models.vehicle.views import BodyPlace, VehicleView, check_speed
 from railopt.models.vehicle.wheelrail import Creep, WheelRail
 
-GRAVITY = 9.80665  # m/s²
 INERTIA_NAMES = {"Ixx": 0, "Iyy": 1, "Izz": 2}
 CONTACT_NAMES = {
     "conicity": "conicity",
@@ -201,7 +201,7 @@ class Vehicle:
             self._cache[track] = assemble(self, track)
         return self._cache[track]
 
-    def lateral(self, track: str = "rigid", speed: float | None = None) -> VehicleModel:
+    def lateral(self, track: str = "rigid", speed: float | None = None) -> VehicleView:
         """Lateral (v, α, γ) model: 9 DOF on rigid and 15 on flexible track for the locomotive."""
         return self._block(track, LATERAL_DOFS, speed)
 
@@ -214,15 +214,15 @@ class Vehicle:
 
         return cab_lateral_model(self, cab_input or CabInput()).at()
 
-    def vertical(self, track: str = "rigid", speed: float | None = None) -> VehicleModel:
+    def vertical(self, track: str = "rigid", speed: float | None = None) -> VehicleView:
         """Longitudinal–vertical (u, w, β) model: 21 / 27 DOF for the locomotive."""
         return self._block(track, VERTICAL_DOFS, speed)
 
-    def full(self, track: str = "rigid", speed: float | None = None) -> VehicleModel:
+    def full(self, track: str = "rigid", speed: float | None = None) -> VehicleView:
         """All independent coordinates together (both blocks)."""
         return self._block(track, LATERAL_DOFS + VERTICAL_DOFS, speed)
 
-    def _block(self, track: str, dofs: tuple[str, ...], speed: float | None) -> VehicleModel:
+    def _block(self, track: str, dofs: tuple[str, ...], speed: float | None) -> VehicleView:
         if speed is not None:
             speed = check_speed(speed)
         a = self.assembly(track)
@@ -235,12 +235,13 @@ class Vehicle:
             To = a.T[:, others]
             # at the current values: a pair of parameters may each break symmetry while their sum keeps it
             # (the thesis's C17 and C18 of the outer axles, equal "because of symmetry")
-            mats = [a.M, a.K(), a.C(1.0) - a.C_creep, a.C_creep]
-            worst = max(float(np.max(np.abs(T.T @ m @ To))) for m in mats)
-            if worst != 0.0:
+            # (a cross term at rounding level, 1e-12 of the matrix's largest entry, is not a coupling)
+            mats = [a.M, a.K(), a.C_const(), a.C_creep]
+            worst = max(float(np.max(np.abs(T.T @ m @ To))) / max(float(np.max(np.abs(m))), 1e-300) for m in mats)
+            if worst > 1e-12:
                 raise ValueError(f"vehicle {self.name!r}: the {'/'.join(dofs)} block couples to the other "
-                                 f"coordinates (|cross term| up to {worst:.3g}); the vehicle is not symmetric, "
-                                 "use .full()")
+                                 f"coordinates (|cross term| up to {worst:.3g} of the largest entry); the vehicle is "
+                                 "not symmetric, use .full()")
 
         def red(m: np.ndarray) -> np.ndarray:
             return T.T @ m @ T
@@ -252,14 +253,19 @@ class Vehicle:
         rows = {}
         if self.cab_point is not None:
             rows.update(self._cab_rows(a, T))
-        return VehicleModel(
+        wr = self.contact
+        return VehicleView(
+            name=self.name, track=track,
             coordinates=tuple(a.independent[j] for j in cols),
             inputs=tuple(a.inputs[j] for j in icols),
             M=red(a.M), K0=red(a.K0), C0=red(a.C0), C_creep=red(a.C_creep),
             parts=parts, values=dict(a.values),
             M_in=T.T @ a.M @ E, K_in0=T.T @ a.K0 @ E, C_in0=T.T @ a.C0 @ E, C_in_creep=T.T @ a.C_creep @ E,
             in_parts=in_parts, speed=speed, output_rows=rows, aliases=self.element_aliases(),
-            track=track, vehicle=self,
+            all_coordinates=a.coordinates, T=T, T_in=T_in,
+            bodies=tuple(BodyPlace(b.name, b.kind, b.cg) for b in a.bodies),
+            wheelsets=tuple((b.name, float(b.cg[0])) for b in self.wheelsets()),
+            semi_gauge=None if wr is None else wr.e0, block_dofs=dofs,
         )
 
     def _cab_rows(self, a: Assembly, T: np.ndarray) -> dict[str, np.ndarray]:

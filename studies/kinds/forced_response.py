@@ -105,6 +105,13 @@ class ForcedResponseConfig(ModelsStudy):
         return self
 
 
+def _vehicle(options: VehicleForcedOptions):
+    from railopt.models.vehicle import load_vehicle
+
+    vehicle = load_vehicle(options.vehicle)
+    return vehicle.with_parameters(options.parameters) if options.parameters else vehicle
+
+
 def _model(options: VehicleForcedOptions, where: str):
     try:
         return vehicle_forced_model(options)
@@ -168,7 +175,7 @@ def run(config: ForcedResponseConfig, context: StudyContext) -> StudyOutcome:
                                       "frequency_hz": f_peak, "certified": certified})
             if track == "flexible" and sys is not None:
                 modes += _modes(g.label, label, model, sys, cfg.track_mode_min_hz)
-                tracks.append((g.label, model.vehicle.lumped_track()))
+                tracks.append((g.label, _vehicle(opts).lumped_track()))
         for p in g.panels:
             for b in g.bands:
                 rows = {t: responses[(t, b.label, p.output)] for t in TRACKS}

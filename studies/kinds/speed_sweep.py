@@ -115,7 +115,7 @@ def run(config: SpeedSweepConfig, context: StudyContext) -> StudyOutcome:
     for i, ref in enumerate(cfg.models):
         setup = ref.setup(f"models[{i}]")
         model = setup.speed_model(setup.defaults)
-        locus = root_locus(model, speeds=cfg.speeds.speeds()).assign(model=ref.label)
+        locus = root_locus(model, cfg.speeds.speeds()).to_pandas().assign(model=ref.label)
         loci.append(locus)
         g = locus.groupby("speed")
         damping.append(pd.DataFrame({"model": ref.label, "speed_m_s": g["real"].max().index,

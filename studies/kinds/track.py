@@ -32,7 +32,7 @@ from railopt.models.track import (
     transient,
 )
 from railopt.models.track.parameters import RAILS
-from railopt.models.track.units import INCH, MPH, POUND_FORCE, PSI
+from railopt.models.units import INCH, MPH, POUND_FORCE, PSI
 from railopt.studies.base import StrictModel, StudyContext, StudyHeader, StudyKind, StudyOutcome, register_kind
 from railopt.studies.figures import Curve, plot_amplification, plot_profiles, plot_time_histories
 

@@ -14,14 +14,18 @@ from __future__ import annotations
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg as sla
 
-from railopt.models import response_maxima as _rm
 from railopt.models.forcing import Forcing, ForcingLike, as_forcing
-from railopt.models.pole_residue import CONDITION_LIMIT, Modal, PoleResidue, modal
-from railopt.models.validation import real_array, square_matrix
+from railopt.models.modal import CONDITION_LIMIT, UNDAMPED_ROOT, Modal, modal, mode_order
+from railopt.models.pole_residue import PoleResidue
+from railopt.models.validation import frequencies_rad_s, real_array, square_matrix
+
+if TYPE_CHECKING:  # pragma: no cover
+    from railopt.models.response_maxima import ResponseMaxima
 
 RESPONSE_ORDER = {"displacement": 0, "velocity": 1, "acceleration": 2}
 SINGULAR_PIVOT = 1e-14  # relative LU pivot below which Z(Ω) counts as singular (response = inf)
@@ -68,16 +72,6 @@ def _output(name: str, spec: object, n: int) -> Output:
     return Output(arr, quantity, feedthrough)
 
 
-def mode_order(s: np.ndarray) -> np.ndarray:
-    """Order of 2n roots by |Im s| then Re s; every second entry ([1::2]) is one root per mode.
-
-    Sorting by |Im s| puts each conjugate pair side by side; real (overdamped) roots also pair
-    up, each pair counting as one mode with ω_d = 0, so the count is always n, as the clipping
-    rule of SPEC §2.4 needs.
-    """
-    return np.lexsort((s.real, np.abs(s.imag)))
-
-
 class LinearSystem:
     """A forced linear system ``M x'' + C x' + K x = F(Ω) e^{iΩt}`` with named outputs.
 
@@ -103,7 +97,7 @@ class LinearSystem:
         M: np.ndarray,
         C: np.ndarray,
         K: np.ndarray,
-        F: ForcingLike,
+        F: ForcingLike | None = None,
         output: np.ndarray | None = None,
         response: str = "displacement",
         names: Sequence[str] | None = None,
@@ -113,27 +107,27 @@ class LinearSystem:
         n = self.M.shape[0]
         self.C = square_matrix("C", C, n)
         self.K = square_matrix("K", K, n)
-        if (output is None) == (outputs is None):
-            raise ValueError("output: give exactly one of output (a row) or outputs (a mapping of named rows)")
+        if output is not None and outputs is not None:
+            raise ValueError("output: give one of output (a row) or outputs (a mapping of named rows), not both")
         if response not in RESPONSE_ORDER:
             raise ValueError(f"response: must be one of {sorted(RESPONSE_ORDER)}, got {response!r}")
-        specs = {DEFAULT_OUTPUT: (output, response)} if outputs is None else dict(outputs)
-        if not specs:
-            raise ValueError("outputs: at least one output is needed")
-        self.outputs = {str(k): _output("output" if outputs is None else f"outputs[{k!r}]", v, n)
+        specs = {DEFAULT_OUTPUT: (output, response)} if output is not None else dict(outputs or {})
+        self.outputs = {str(k): _output("output" if output is not None else f"outputs[{k!r}]", v, n)
                         for k, v in specs.items()}
-        self.forcing = as_forcing(F, n)
+        self.forcing = as_forcing(np.zeros(n) if F is None else F, n)
         self.names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(n))
         if len(self.names) != n:
             raise ValueError(f"names: expected {n} names, got {len(self.names)}")
+        self.tangent: Tangent | None = None
         self._prepare()
 
     @classmethod
     def _trusted(cls, M: np.ndarray, C: np.ndarray, K: np.ndarray, forcing: Forcing,
-                 outputs: dict[str, Output], names: tuple[str, ...]) -> LinearSystem:
-        """Fast path for parametric updates: inputs already validated, only M re-checked."""
+                 outputs: dict[str, Output], names: tuple[str, ...], tangent: Tangent | None = None) -> LinearSystem:
+        """Fast path for a family's members: inputs already validated, only M re-checked."""
         self = cls.__new__(cls)
         self.M, self.C, self.K, self.forcing, self.outputs, self.names = M, C, K, forcing, outputs, names
+        self.tangent = tangent
         self._prepare()
         return self
 
@@ -162,6 +156,8 @@ class LinearSystem:
         return tuple(self.outputs)
 
     def _out(self, output: str | None) -> Output:
+        if not self.outputs:
+            raise ValueError("output: this system has no outputs (it was built for eigen-analysis only)")
         if output is None:
             return next(iter(self.outputs.values()))
         try:
@@ -183,9 +179,17 @@ class LinearSystem:
     def order(self) -> int:
         return self._out(None).order
 
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """Names of the parameters whose derivatives the system carries (a family's member), else ()."""
+        return () if self.tangent is None else self.tangent.parameters
+
     def __repr__(self) -> str:
         outs = ", ".join(f"{k} ({o.quantity})" for k, o in self.outputs.items())
-        return f"LinearSystem(n={self.n}, outputs=[{outs}], forcing={self.forcing!r})"
+        extra = "" if self.tangent is None else f", parameters={list(self.tangent.parameters)}"
+        if self.tangent is not None and self.tangent.speed is not None:
+            extra += f", speed={self.tangent.speed:g} m/s"
+        return f"LinearSystem(n={self.n}, outputs=[{outs}], forcing={self.forcing!r}{extra})"
 
     # ------------------------------------------------------------------ eigen-analysis (4.51-4.58)
     def state_matrix(self) -> np.ndarray:
@@ -209,7 +213,8 @@ class LinearSystem:
         return self._eigvals
 
     def eigenvalues(self) -> np.ndarray:
-        """The 2n roots ``s_j = μ_j ± iω_dj`` of (4.58), sorted by |Im s| then Re s."""
+        """The 2n roots ``s_j = μ_j ± iω_dj`` of (4.58), 1/s, in railopt's one order: ascending |Im s|,
+        then ascending Re s (:func:`~railopt.models.modal.mode_order`)."""
         s = self._roots()
         return s[mode_order(s)]
 
@@ -219,9 +224,9 @@ class LinearSystem:
         return s[mode_order(s)[1::2]]
 
     def undamped_modes(self) -> np.ndarray:
-        """Boolean (n,): modes whose root lies on the imaginary axis to rounding (|Re s| ≤ 1e-12 |s|)."""
+        """Boolean (n,): modes whose root lies on the imaginary axis to rounding (|Re s| ≤ UNDAMPED_ROOT·|s|)."""
         s = self.mode_roots()
-        return (np.abs(s.real) <= _rm.UNDAMPED_ROOT * np.abs(s)) & (s.imag != 0)
+        return (np.abs(s.real) <= UNDAMPED_ROOT * np.abs(s)) & (s.imag != 0)
 
     def damped_frequencies(self) -> np.ndarray:
         """Damped natural frequencies ω_dj (rad/s), n values sorted ascending (eq. 4.58)."""
@@ -283,9 +288,15 @@ class LinearSystem:
         ``H_o(Ω) = (iΩ)^q_o c_o·Z(Ω)⁻¹F(Ω)``; a singular Z (an undamped resonance hit exactly)
         gives ``inf``.
         """
-        w = np.atleast_1d(np.asarray(omega, dtype=float)).ravel()
+        self._out(None)  # a system without outputs has no response
+        w = frequencies_rad_s(omega)
         F = np.array([self.forcing_at(float(x)) for x in w], dtype=complex).reshape(len(w), self.n)
-        Z = (self.K[None] - w[:, None, None] ** 2 * self.M[None]) + 1j * w[:, None, None] * self.C[None]
+        with np.errstate(over="ignore", invalid="ignore"):
+            Z = (self.K[None] - w[:, None, None] ** 2 * self.M[None]) + 1j * w[:, None, None] * self.C[None]
+        if not np.all(np.isfinite(Z)):
+            bad = w[~np.all(np.isfinite(Z), axis=(1, 2))]
+            raise ValueError(f"omega: Z(Ω) = K − Ω²M + iΩC overflows at {bad[:3].tolist()} rad/s; "
+                             "no response can be computed there")
         try:
             X = np.linalg.solve(Z, F[..., None])[..., 0]
         except np.linalg.LinAlgError:  # a singular Z somewhere: point by point with pivot checks
@@ -317,7 +328,7 @@ class LinearSystem:
 
     def frf(self, omega: float | np.ndarray, output: str | None = None) -> complex | np.ndarray:
         """Complex frequency response of one output at Ω (rad/s), scalar or array (direct solves)."""
-        w = np.asarray(omega, dtype=float)
+        w = np.asarray(frequencies_rad_s(omega)).reshape(np.shape(omega))
         h = self.frf_outputs(w.ravel())[:, self.output_index(output)]
         return complex(h[0]) if w.ndim == 0 else h.reshape(w.shape)
 
@@ -325,12 +336,53 @@ class LinearSystem:
         """``f(Ω) = |H(Ω)|``: the real-valued transfer function of (4.71)."""
         return np.abs(self.frf(omega, output))
 
-    # ------------------------------------------------------------------ response maxima (4.71-4.73)
+    # ------------------------------------------------------------------ thin delegates (railopt.models.response_maxima)
     def response_maxima(self, band: tuple[float, float], exact: bool = False,
-                        output: str | None = None) -> _rm.ResponseMaxima:
-        """The n+2 response maxima f_k of (4.71)-(4.73); see :func:`response_maxima`."""
-        return _rm.response_maxima(self, band, exact=exact, output=output)
+                        output: str | None = None) -> ResponseMaxima:
+        """The n+2 response maxima f_k of (4.71)-(4.73) over ``band`` (rad/s);
+        see :func:`railopt.models.response_maxima.response_maxima`."""
+        from railopt.models.response_maxima import response_maxima
+
+        return response_maxima(self, band, exact=exact, output=output)
 
     def peak(self, band: tuple[float, float], exact: bool = True, output: str | None = None) -> float:
-        """``U = max_k f_k`` (4.74) over ``band``; ``exact=True`` gives the certified band maximum."""
-        return self.response_maxima(band, exact=exact, output=output).value
+        """``U = max_k f_k`` (4.74) over ``band`` (rad/s); see :func:`railopt.models.response_maxima.peak`."""
+        from railopt.models.response_maxima import peak
+
+        return peak(self, band, exact=exact, output=output)
+
+
+@dataclass(frozen=True, eq=False)
+class Tangent:
+    """Derivatives of a family member's matrices with respect to its parameters and its speed.
+
+    A :class:`~railopt.models.parametric.ParametricSystem` attaches one to every system it builds, so
+    analyses of sensitivity (:mod:`railopt.models.sensitivity`) need only the system.
+
+    Attributes
+    ----------
+    parameters : tuple of str
+        Parameter names, length P.
+    p : (P,) ndarray
+        Parameter values of this member (SI).
+    dM, dC, dK : (P, n, n) ndarray
+        ∂M/∂p_i, ∂C/∂p_i, ∂K/∂p_i.
+    dF : tuple of Forcing or None
+        ∂F/∂p_i (None where F does not depend on p_i).
+    speed : float or None
+        Forward speed S of this member, m/s (None for a family without a speed term).
+    dC_dspeed : (n, n) ndarray or None
+        ∂C/∂S (= −C_speed/S²).
+    dF_dspeed : callable or None
+        ``Ω -> ∂F/∂S (n,)`` at this speed (delays d/S and creep inputs F_speed/S), or None.
+    """
+
+    parameters: tuple[str, ...]
+    p: np.ndarray
+    dM: np.ndarray
+    dC: np.ndarray
+    dK: np.ndarray
+    dF: tuple[Forcing | None, ...]
+    speed: float | None = None
+    dC_dspeed: np.ndarray | None = None
+    dF_dspeed: object = None

@@ -1,0 +1,55 @@
+"""Eigen-decomposition of the state matrix G (thesis eqs. 4.53–4.58) and the one mode ordering.
+
+The 2n roots of ``G`` come as conjugate pairs ``s = μ ± iω_d`` (and real pairs for overdamped
+modes).  railopt orders roots in one way everywhere (:func:`mode_order`): **ascending |Im s|, then
+ascending Re s**, so each conjugate pair sits side by side and every second entry is one root per
+mode in ascending damped natural frequency.  Stability questions (the largest real part) never
+rely on an ordering: they use :func:`railopt.models.stability.spectral_abscissa`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from railopt.records import ArrayRecord
+
+UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
+CONDITION_LIMIT = 1e8  # cond₁(V) above which the pole–residue form is not used (errors ≳ 1e-8)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Modal(ArrayRecord):
+    """Eigen-decomposition of the state matrix G (4.53): roots s (2n,), right eigenvectors V
+    (columns) and left ones W = V⁻¹ (rows, so W V = I); ``condition`` = ‖V‖₁‖W‖₁ (inf when V
+    is singular)."""
+
+    s: np.ndarray
+    V: np.ndarray
+    W: np.ndarray
+    condition: float
+
+
+def modal(G: np.ndarray) -> Modal:
+    """Right and left eigenvectors of G with the normalisation W V = I."""
+    s, V = np.linalg.eig(G)
+    try:
+        W = np.linalg.solve(V, np.eye(V.shape[0]))
+        condition = float(np.linalg.norm(V, 1) * np.linalg.norm(W, 1))
+    except np.linalg.LinAlgError:
+        W = np.full_like(V, np.nan)
+        condition = float("inf")
+    if not np.isfinite(condition):
+        condition = float("inf")
+    return Modal(s, V, W, condition)
+
+
+def mode_order(s: np.ndarray) -> np.ndarray:
+    """Order of 2n roots by |Im s| then Re s (ascending); every second entry ([1::2]) is one root per mode.
+
+    Sorting by |Im s| puts each conjugate pair side by side; real (overdamped) roots also pair
+    up, each pair counting as one mode with ω_d = 0, so the count is always n, as the clipping
+    rule of SPEC §2.4 needs.
+    """
+    return np.lexsort((s.real, np.abs(s.imag)))
