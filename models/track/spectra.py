@@ -11,7 +11,8 @@ Analytic spectra (all the rational form ``S(Ω) = b₀ / ((Ω² + p₁²)(Ω² +
 
 * FRA / AAR track classes 1–6 (Hamid, Rasmussen, Baluja & Yang, *Analytical descriptions of track
   geometry variations*, DOT/FRA/ORD-83/03.1, 1983; constants as tabulated e.g. in W. Zhai,
-  *Vehicle–Track Coupled Dynamics*, Springer 2020, §2.x "American track spectra"):
+  *Vehicle–Track Coupled Dynamics: Theory and Applications*, Springer 2020, Ch. 2, American track
+  spectra):
 
   - vertical profile  ``S_v(Ω) = k A_v Ω_c² / (Ω² (Ω² + Ω_c²))``,
   - alignment         ``S_a(Ω) = k A_a Ω_c² / (Ω² (Ω² + Ω_c²))``,
