@@ -35,7 +35,8 @@ EN 12299 comfort (floor accelerations, x longitudinal, y lateral, z vertical; d 
   percentiles of the RMS values over consecutive 5-s blocks (the standard takes 60 blocks, 5 min)
   (:func:`mean_comfort`);
 * mean comfort, complete method, standing ``N_VD = 3·sqrt(16 a_XP,d,50² + 4 a_YP,d,50² + a_ZP,b,50²)
-  + 5 a_YP,d,95`` (50th and 95th percentiles) (:func:`standing_comfort`);
+  + 5 a_YP,d,95`` (50th and 95th percentiles) (:func:`standing_comfort`; the formula as reproduced in
+  the secondary literature — not checked against the text of the standard);
 * classes (:func:`comfort_class`): N < 1 very comfortable, 1 ≤ N < 2 comfortable, 2 ≤ N < 4 medium,
   4 ≤ N < 5 uncomfortable, N ≥ 5 very uncomfortable.
 

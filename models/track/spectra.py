@@ -21,7 +21,10 @@ Analytic spectra (all the rational form ``S(Ω) = b₀ / ((Ω² + p₁²)(Ω² +
   with k = 0.25, A_v, A_a in cm²·rad/m (× 1e-4 to m²·rad/m), Ω_c, Ω_s in rad/m (table
   :data:`FRA_CLASSES`), valid for wavelengths 1.524–304.8 m (5–1000 ft), i.e.
   Ω ∈ [2π/304.8, 2π/1.524] rad/m.  The cross-level spectrum is a height difference between the rails
-  (m²/(rad/m)); divide by the squared rail-contact base for a roll angle.
+  (m²/(rad/m)); divide by the squared rail-contact base for a roll angle.  Classes 5 and 6 are
+  cross-checked against the public ORVD implementation (``aar_track_irregularity_generator``: A, k,
+  Ω_c and its published band RMS); the constants of classes 1–4 and Ω_s are as tabulated by Zhai and
+  were not checked against a retrieved copy of the FRA report.
 * ERRI B176 (ORE/ERRI B176 RP1, 1989; the form used by SIMPACK's predefined PSD library):
   ``S(Ω) = A Ω_c² / ((Ω² + Ω_r²)(Ω² + Ω_c²))`` with Ω_c = 0.8246 rad/m, Ω_r = 0.0206 rad/m and A
   (m·rad) = 4.032e-7 (profile, low), 1.080e-6 (profile, high), 2.119e-7 (alignment, low),
