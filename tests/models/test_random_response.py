@@ -65,6 +65,23 @@ def test_sdof_rms_equals_independent_quadrature(key, zeta, quantity):
     assert got == pytest.approx(math.sqrt(expected), rel=1e-6)
 
 
+def test_sdof_rms_under_measured_table_equals_independent_quadrature(tmp_path):
+    """A measured (CSV) spectrum: a tabulated power law S = c Ω⁻³ (log–log interpolation is exact for it)."""
+    w = np.geomspace(0.05, 5.0, 7)
+    path = tmp_path / "measured.csv"
+    path.write_text("".join(f"{float(x)!r},{float(3e-8 * x**-3)!r}\n" for x in w))
+    spec = irregularity_spectrum.from_table(path)
+    m, k, zeta, V, band = 1000.0, 4.0e5, 0.05, 30.0, (0.5, 15.0)
+    c = 2 * zeta * math.sqrt(k * m)
+
+    def integrand(x):
+        return abs((k + 1j * x * c) / (k - m * x * x + 1j * x * c)) ** 2 * 3e-8 * (x / V) ** -3 / V
+
+    expected, _ = quad(integrand, TWO_PI * band[0], TWO_PI * band[1], points=[math.sqrt(k / m)], epsabs=0,
+                       epsrel=1e-13, limit=500)
+    assert rms(sdof(m, k, zeta), spec, V, band) == pytest.approx(math.sqrt(expected), rel=1e-6)
+
+
 def test_quadrature_rule_is_reusable_and_error_controlled():
     system = sdof(1000.0, 4.0e5, 0.001)  # a very lightly damped peak
     spec = irregularity_spectrum("erri_b176", level="low", component="profile")
