@@ -51,7 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from railopt.models.linear_system import LinearSystem
+from railopt.models.system import LinearSystem
 from railopt.models.validation import number
 
 TWO_PI = 2.0 * math.pi
