@@ -396,14 +396,10 @@ def rms_state_space(system: LinearSystem, spectrum: object, speed_m_s: float, ou
         c_row = c_row @ T
     n = M.shape[0]
     minv = np.linalg.inv(M)
-    A = np.zeros((2 * n, 2 * n))
-    A[:n, n:] = np.eye(n)
-    A[n:, :n] = -minv @ K
-    A[n:, n:] = -minv @ C
-    lam, vec = np.linalg.eig(A)
-    if np.linalg.cond(vec) > 1e12:
+    decomposition = LinearSystem(M, C, K).modal()  # the one state matrix G (4.53)
+    lam, vec, W = decomposition.s, decomposition.V, decomposition.W
+    if decomposition.condition > 1e12:
         raise ValueError("system: the state matrix is (nearly) defective; the modal covariance is unreliable")
-    W = np.linalg.inv(vec)
     alpha, beta = (V * float(p) for p in sorted(corners))
     if math.isclose(alpha, beta, rel_tol=1e-9):
         raise ValueError("spectrum: equal corners p₁ = p₂ are not supported by the state-space method")

@@ -90,3 +90,16 @@ def frequencies_rad_s(value: object, name: str = "omega") -> np.ndarray:
     if np.any(w < 0):
         raise ValueError(f"{name}: frequencies must be ≥ 0, got {w[w < 0][:3].tolist()}")
     return w
+
+
+def positive(name: str, value: object) -> float:
+    """A finite real number > 0."""
+    return number(name, value, positive=True)
+
+
+def poisson(name: str, value: object) -> float:
+    """Poisson's ratio in [0, 0.5]."""
+    x = number(name, value)
+    if not 0.0 <= x <= 0.5:
+        raise ValueError(f"{name}: Poisson's ratio must lie in [0, 0.5], got {x}")
+    return x

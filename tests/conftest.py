@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from railopt.models import LinearSystem, ParameterPart, ParametricSystem
+from railopt.models.vehicle import load_vehicle
 
 
 def random_system(n: int, seed: int, damping: float = 0.05) -> LinearSystem:
@@ -48,3 +49,15 @@ def base_excited_parametric(seed: int = 3) -> ParametricSystem:
         "k_12": ParameterPart(K=np.array([[1.0, -1.0, 0], [-1.0, 1.0, 0], [0, 0, 0]])),
     }
     return ParametricSystem(M, C0, K0, np.zeros(n), np.array([0.0, 0.0, 1.0]), parts, response="acceleration")
+
+
+@pytest.fixture(scope="session")
+def sd40():
+    """The bundled locomotive (its assembly cache is shared by the tests that use it)."""
+    return load_vehicle("sd40-2")
+
+
+@pytest.fixture(scope="session")
+def coach():
+    """The bundled Manchester benchmark coach."""
+    return load_vehicle("manchester-coach")

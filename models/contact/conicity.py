@@ -30,7 +30,8 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from railopt.models.contact._checks import finite, positive
+from railopt.models.validation import number as finite
+from railopt.models.validation import positive
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(24)
 

@@ -30,7 +30,8 @@ import numpy as np
 from scipy.special import ellipe, ellipk, gammaln
 
 from railopt.models.contact import kalker_table
-from railopt.models.contact._checks import finite, poisson, positive
+from railopt.models.validation import number as finite
+from railopt.models.validation import poisson, positive
 
 Theory = Literal["vermeulen-johnson", "kalker", "carter"]
 THEORIES: tuple[str, ...] = ("vermeulen-johnson", "kalker", "carter")

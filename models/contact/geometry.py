@@ -31,7 +31,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from railopt.models.contact._checks import finite, positive
+from railopt.models.validation import number as finite
+from railopt.models.validation import positive
 
 
 @dataclass(frozen=True)

@@ -25,8 +25,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from railopt.models.contact._checks import finite, positive
 from railopt.models.contact.geometry import WheelRailGeometry
+from railopt.models.validation import number as finite
+from railopt.models.validation import positive
 
 
 def lateral_gravity_stiffness(W: float, geometry: WheelRailGeometry) -> float:

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
-from railopt.models.contact._checks import finite, poisson, positive
+from railopt.models.validation import number as finite
+from railopt.models.validation import poisson, positive
 
 
 def _curvature_ratio(g: float) -> float:

@@ -13,20 +13,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from railopt.models.track.lumped import LumpedTrack
-    from railopt.models.track.moving_load import MovingLoadSolution
-
-
-def _check_finite(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name}: must be a finite number, got {value!r}")
-    return value
+from railopt.models.validation import number as _check_finite
 
 
 def _check_positive(name: str, value: float) -> float:
@@ -163,37 +153,6 @@ class Beam:
         fields = {"EI": self.EI, "m": self.m, "k": self.k, "c": self.c, "N": self.N}
         fields.update(changes)
         return Beam(**fields)
-
-    # --- thin delegates to the analysis functions ----------------------------------------------
-    def static_deflection(self, x: np.ndarray | float, P: float) -> np.ndarray:
-        """Static deflection under a point load ``P`` (N) at ``x = 0``, m; see :func:`static_deflection`."""
-        from railopt.models.track.moving_load import static_deflection
-
-        return static_deflection(self, x, P)
-
-    def moving_load(self, xi: np.ndarray, P: float, v: float, method: str = "closed") -> MovingLoadSolution:
-        """Steady state under a load moving at ``v``; see :func:`~railopt.models.track.moving_load`."""
-        from railopt.models.track.moving_load import moving_load
-
-        return moving_load(self, xi, P, v, method=method)
-
-    def impulse_response_at_load(self, t: np.ndarray, impulse: float, method: str = "closed") -> np.ndarray:
-        """Deflection at the load point after an impulse; see :func:`impulse_response_at_load`."""
-        from railopt.models.track.impulse import impulse_response_at_load
-
-        return impulse_response_at_load(self, t, impulse, method=method)
-
-    def transient(self, x: np.ndarray, t: np.ndarray, load: object, **options: float):
-        """Transient response from rest; see :func:`railopt.models.track.transient.transient`."""
-        from railopt.models.track.transient import transient
-
-        return transient(self, x, t, load, **options)
-
-    def lumped(self, damping_ratio: float, contact_spacing: float = 1.5) -> LumpedTrack:
-        """Lumped equivalent track under a wheelset; see :func:`railopt.models.track.lumped.lumped`."""
-        from railopt.models.track.lumped import lumped
-
-        return lumped(self, damping_ratio, contact_spacing=contact_spacing)
 
 
 def hetenyi_deflection(x: np.ndarray | float, P: float, k: float, EI: float) -> np.ndarray:

@@ -36,7 +36,8 @@ import numpy as np
 import pandas as pd
 from scipy import special
 
-from railopt.models.track.beam import Beam, _check_finite
+from railopt.models.track.beam import Beam
+from railopt.models.validation import number as _check_finite
 from railopt.records import ArrayRecord
 
 

@@ -19,7 +19,6 @@ from railopt.models.vehicle import (
     forced_parametric,
     forced_system,
     frequency_response,
-    load_vehicle,
     parse_vehicle,
 )
 from railopt.models.vehicle.irregularity import Irregularity, RailInput, frequency_hz, wavelength_m
@@ -29,11 +28,6 @@ HZ = 2 * np.pi
 VERTICAL = Irregularity("vertical", 1.0)
 FIGURE_OUTPUTS = ["body.u", "body.w", "body.beta", "frame_rear.w", "frame_front.beta", "motor3.beta",
                   "wheelset3.beta", "wheelset3_track.w"]
-
-
-@pytest.fixture(scope="module")
-def sd40():
-    return load_vehicle("sd40-2")
 
 
 def small_vehicle(bodies: list[dict], elements: list[dict]) -> dict:

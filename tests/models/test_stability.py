@@ -12,11 +12,6 @@ from railopt.models.stability import CriticalSpeed, critical_speed, root_locus, 
 from railopt.models.vehicle import load_vehicle
 
 
-@pytest.fixture(scope="module")
-def sd40():
-    return load_vehicle("sd40-2")
-
-
 def first_unstable_speed(vehicle, track: str, lo: float, hi: float, step: float) -> float:
     """Lowest speed of a dense grid with a root in Re s > 0 (the independent reference)."""
     speeds = np.arange(lo, hi + step / 2, step)

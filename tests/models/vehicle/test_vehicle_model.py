@@ -13,11 +13,6 @@ LB = 0.45359237  # kg
 GRAVITY = 9.80665
 
 
-@pytest.fixture(scope="module")
-def sd40():
-    return load_vehicle("sd40-2")
-
-
 @pytest.mark.parametrize(
     ("name", "track", "lateral", "vertical"),
     [

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_delayed_forcing import brute_force_peak, delayed_system
+from test_forcing import brute_force_peak, delayed_system
 
 from railopt.models import CONDITION_LIMIT, Forcing, LinearSystem
 
