@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -61,3 +63,23 @@ def sd40():
 def coach():
     """The bundled Manchester benchmark coach."""
     return load_vehicle("manchester-coach")
+
+
+def routh_hurwitz(m: float, iz: float, ky: float, kpsi: float, f11: float, f22: float, lam: float, e0: float,
+                  r0: float) -> tuple[float, float]:
+    """Critical speed (m/s) and hunting frequency (Hz) of an elastically restrained wheelset on rigid track,
+    no spin creep and no gravity stiffness, derived by Routh–Hurwitz:
+
+        m v'' + 2 f22 (v'/S − ψ) + k_y v = 0,   I ψ'' + 2 f11 e0 (e0 ψ'/S + λ v/r0) + k_ψ ψ = 0.
+
+    With x = 1/S the characteristic polynomial is a4 s⁴ + p x s³ + (q0 + q2 x²) s² + r x s + a0; the Hurwitz
+    determinant a3 a2 a1 − a1² a4 − a3² a0 vanishes at x² = (a4 r² + p² a0 − p r q0)/(p r q2), where the root
+    on the imaginary axis is s = ±i sqrt(r/p).
+    """
+    A, Cc, b = 2 * f22, 2 * e0**2 * f11, 2 * e0 * lam * f11 / r0
+    p = m * Cc + A * iz
+    q0, q2 = m * kpsi + ky * iz, A * Cc
+    r = A * kpsi + Cc * ky
+    a4, a0 = m * iz, ky * kpsi + 2 * f22 * b
+    x2 = (a4 * r**2 + p**2 * a0 - p * r * q0) / (p * r * q2)
+    return 1.0 / math.sqrt(x2), math.sqrt(r / p) / (2 * math.pi)

@@ -22,6 +22,8 @@ import pytest
 from railopt.models.stability import critical_speed
 from railopt.models.vehicle import load_vehicle, parse_vehicle
 
+from conftest import routh_hurwitz
+
 
 def kinematic_root(model, speed: float) -> complex:
     """The oscillatory root with the smallest |s| (the kinematic mode under large creep)."""
@@ -72,18 +74,6 @@ def test_rigid_truck_kinematic_wavelength(n_axles: int, b: float, f11: float, f2
     model = truck.with_parameters({"creep_factor": 1e4}).lateral()
     wavelength = 2 * math.pi * speed / kinematic_root(model, speed).imag
     assert wavelength == pytest.approx(exact, rel=1e-4)
-
-
-def routh_hurwitz(m: float, iz: float, ky: float, kpsi: float, f11: float, f22: float, lam: float, e0: float,
-                  r0: float) -> tuple[float, float]:
-    """Critical speed (m/s) and hunting frequency (Hz) of the restrained wheelset (module docstring)."""
-    A, Cc, b = 2 * f22, 2 * e0**2 * f11, 2 * e0 * lam * f11 / r0
-    p = m * Cc + A * iz  # a3 = p x
-    q0, q2 = m * kpsi + ky * iz, A * Cc  # a2 = q0 + q2 x²
-    r = A * kpsi + Cc * ky  # a1 = r x
-    a4, a0 = m * iz, ky * kpsi + 2 * f22 * b
-    x2 = (a4 * r**2 + p**2 * a0 - p * r * q0) / (p * r * q2)
-    return 1.0 / math.sqrt(x2), math.sqrt(r / p) / (2 * math.pi)
 
 
 @pytest.mark.parametrize(
