@@ -16,6 +16,7 @@ import numpy as np
 from railopt.records import ArrayRecord
 
 UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
+NEUTRAL_ROOT = 1e-8  # |s| ≤ NEUTRAL_ROOT · max|s| counts as s = 0 (a free rigid-body motion, not instability)
 CONDITION_LIMIT = 1e8  # cond₁(V) above which the pole–residue form is not used (errors ≳ 1e-8)
 
 
@@ -53,3 +54,13 @@ def mode_order(s: np.ndarray) -> np.ndarray:
     rule of SPEC §2.4 needs.
     """
     return np.lexsort((s.real, np.abs(s.imag)))
+
+
+def growing_roots(s: np.ndarray) -> np.ndarray:
+    """The roots with Re s > 0 beyond round-off (Re s > UNDAMPED_ROOT·|s|), neutral roots s ≈ 0 excepted:
+    with any of them the system has no steady-state response (thesis (4.59); SPEC §2.4)."""
+    s = np.asarray(s)
+    if s.size == 0:
+        return s
+    scale = float(np.max(np.abs(s)))
+    return s[(s.real > UNDAMPED_ROOT * np.abs(s)) & (np.abs(s) > NEUTRAL_ROOT * scale)]

@@ -89,6 +89,9 @@ class ParametricSystem:
         The family's own parameter values (a vehicle file's suspension), used when ``at`` gets no p.
     speed : float, optional
         The family's own forward speed (m/s), used when ``at`` gets no speed.
+    groups : mapping body -> group, optional
+        How the bodies of the coordinates (``"<body>.<dof>"``) gather for mode names
+        (:func:`railopt.models.stability.modes`); ``main_body`` is the car body.
 
     Raises
     ------
@@ -111,6 +114,8 @@ class ParametricSystem:
         F_speed: FamilyForcing | None = None,
         values: Sequence[float] | Mapping[str, float] | None = None,
         speed: float | None = None,
+        groups: Mapping[str, str] | None = None,
+        main_body: str | None = None,
     ) -> None:
         specs = dict(outputs or {})
         feeds = {}
@@ -141,6 +146,8 @@ class ParametricSystem:
         self.values = None if values is None else self._check(self._vector(values))
         self.speed = None if speed is None else number("speed", speed, positive=True)
         self._at_speed_cache: dict[float | None, tuple] = {}
+        self.groups = dict(groups or {})
+        self.main_body = main_body
 
     # ------------------------------------------------------------------ description
     @property

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from railopt.models.modal import UNDAMPED_ROOT
+from railopt.models.modal import UNDAMPED_ROOT, growing_roots
 from railopt.models.peak_search import cell_maxima
 from railopt.models.validation import band as validate_band
 from railopt.records import ArrayRecord
@@ -78,6 +78,9 @@ class ResponseMaxima(ArrayRecord):
         How H was sampled: ``"thesis"`` (n+2 direct solves), ``"pole-residue"`` or ``"direct"``.
     grid_points : int
         Exact method only: number of frequencies sampled.
+    reason : str
+        Why the values are not certified ("" when they are, or for the thesis method on a stable system);
+        for an unstable system it names the growing root and every value is +inf (no steady state exists).
     """
 
     values: np.ndarray
@@ -90,6 +93,7 @@ class ResponseMaxima(ArrayRecord):
     output: str = "output"
     evaluation: str = "thesis"
     grid_points: int = 0
+    reason: str = ""
 
     @property
     def value(self) -> float:
@@ -120,6 +124,8 @@ class ResponseMaxima(ArrayRecord):
 
     def __repr__(self) -> str:
         kind = ("exact, certified" if self.certified else "exact, not certified") if self.exact else "thesis"
+        if self.reason:
+            kind += f": {self.reason}"
         return (f"ResponseMaxima(U={self.value:.6g} at {self.argmax_frequency:.6g} rad/s, n={len(self.values)}, "
                 f"output={self.output!r}, {kind}, band=({self.band[0]:g}, {self.band[1]:g}) rad/s)")
 
@@ -163,6 +169,14 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
     wd = system.damped_frequencies()
     clipped = np.clip(wd, lo, hi)
     edges = np.array([lo, hi])
+    growing = growing_roots(system.eigenvalues())
+    if growing.size:  # no steady state exists: never a silent number
+        worst = growing[np.argmax(growing.real)]
+        reason = (f"unstable: root s = {worst.real:.6g}{worst.imag:+.6g}i 1/s has Re s > 0, so no steady-state "
+                  "response exists")
+        freqs = np.concatenate([clipped, edges])
+        return {nm: ResponseMaxima(np.full(len(freqs), np.inf), freqs, wd, (lo, hi), exact=exact, certified=False,
+                                   output=nm, evaluation="unstable", reason=reason) for nm in names}
     # an undamped mode inside the band has an unbounded peak, whatever rounding makes of Z(ω_d)
     resonant = system.undamped_modes() & (wd >= lo) & (wd <= hi)
     if not exact:
@@ -186,7 +200,12 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
         pr = None
         result = _exact_cells(system, None, grid, bounds, cols, edges)
     cell_f, cell_x, all_finite, edge_vals = result
-    certified = bool(all_finite and max_delay is not None and ratio <= CERTIFIED_RATIO * (1 + 1e-9))
+    spacing = ratio <= CERTIFIED_RATIO * (1 + 1e-9)
+    certified = bool(all_finite and max_delay is not None and spacing)
+    reason = "" if certified else "; ".join(text for ok, text in (
+        (max_delay is not None, "the forcing does not declare its delays"),
+        (spacing, f"the grid broke the spacing rule (ratio {ratio:.3g})"),
+        (all_finite, "a sample was singular (an undamped or rigid-body pole on the band)")) if not ok)
     out = {}
     for i, (nm, c) in enumerate(zip(names, cols, strict=True)):
         f, x = cell_f[i].copy(), cell_x[i].copy()
@@ -195,7 +214,7 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
         out[nm] = ResponseMaxima(
             np.concatenate([f, edge_vals[:, c]]), np.concatenate([x, edges]), wd, (lo, hi), exact=True,
             certified=certified, grid_ratio=ratio, output=nm,
-            evaluation="direct" if pr is None else "pole-residue", grid_points=len(grid),
+            evaluation="direct" if pr is None else "pole-residue", grid_points=len(grid), reason=reason,
         )
     return out
 

@@ -131,3 +131,32 @@ def response_maxima_jacobian(system: LinearSystem, band: tuple[float, float], ex
     """f_k of one output of a family member and its analytic Jacobian ``df_k/dp_i``, shape (n+2, P)."""
     name = system.output_names[system.output_index(output)]
     return maxima_jacobians(system, band, exact=exact, outputs=[name])[name]
+
+
+def root_jacobian(system: LinearSystem) -> np.ndarray:
+    """``ds_k/dp_i`` (2n, P) of every root of a family member, roots in ``system.modal().s`` order.
+
+    For the quadratic eigenproblem (s²M + sC + K)v = 0 with left vector w this is
+    ``ds/dp = −wᴴ(s²M′ + sC′ + K′)v / wᴴ(2sM + C)v`` (SPEC §2.5); computed here as the first-order
+    perturbation of G (4.53) with its left and right eigenvectors, which is the same number.
+    """
+    t = _tangent(system)
+    return eigenvalue_derivatives(system, t.dM, t.dC, t.dK)
+
+
+def root_speed_derivative(system: LinearSystem) -> np.ndarray:
+    """``ds_k/dS`` (2n,) of every root of a family member with respect to the forward speed (the creep damping
+    C_speed/S), roots in ``system.modal().s`` order."""
+    t = _tangent(system)
+    if t.dC_dspeed is None:
+        raise ValueError("system: its family has no speed term in the damping (C_speed)")
+    n = system.n
+    zero = np.zeros((1, n, n))
+    return eigenvalue_derivatives(system, zero, t.dC_dspeed[None], zero)[:, 0]
+
+
+def damping_ratio_jacobian(s: np.ndarray, ds: np.ndarray) -> np.ndarray:
+    """``dζ/dθ`` of ζ = −Re s/|s| for roots ``s`` (k,) with derivatives ``ds`` (k, Q)."""
+    mag = np.abs(s)[:, None]
+    dmag = np.real(np.conj(s)[:, None] * ds) / mag
+    return -(ds.real * mag - s.real[:, None] * dmag) / mag**2

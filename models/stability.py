@@ -15,18 +15,18 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
+from railopt.models.modal import NEUTRAL_ROOT, mode_order
+from railopt.models.sensitivity import damping_ratio_jacobian, root_jacobian, root_speed_derivative
 from railopt.models.system import LinearSystem
 from railopt.models.validation import number
 from railopt.records import ArrayRecord
-
-NEUTRAL_ROOT = 1e-8  # |s| ≤ NEUTRAL_ROOT · max|s| counts as s = 0 (a free rigid-body motion, not instability)
 
 
 def abscissa(s: np.ndarray) -> float:
@@ -36,8 +36,8 @@ def abscissa(s: np.ndarray) -> float:
     return float(np.max(live.real)) if live.size else 0.0
 
 
-def _speed_function(model: object, track: str | None) -> Callable[[float], LinearSystem]:
-    """``S -> LinearSystem`` for a model with ``at(speed=S)``, or a vehicle with ``lateral(track)``."""
+def _resolve(model: object, track: str | None) -> object:
+    """The model with ``at(speed=S)``: as given, or a vehicle's lateral view on ``track``."""
     if isinstance(model, LinearSystem):
         raise ValueError("model: a LinearSystem has one speed; give a model with at(speed=S) (a vehicle view or a "
                          "ParametricSystem with a speed term)")
@@ -47,15 +47,23 @@ def _speed_function(model: object, track: str | None) -> Callable[[float], Linea
         model = model.lateral(track=track or "rigid")
     if not callable(getattr(model, "at", None)):
         raise ValueError(f"model: needs a method at(speed=S) returning a LinearSystem, got {type(model).__name__}")
-    return lambda S: model.at(speed=S)
+    return model
+
+
+def _speed_function(model: object, track: str | None) -> Callable[[float], LinearSystem]:
+    """``S -> LinearSystem`` for a model with ``at(speed=S)``, or a vehicle with ``lateral(track)``."""
+    resolved = _resolve(model, track)
+    return lambda S: resolved.at(speed=S)
 
 
 class _Counted:
     """``S -> system`` with a count of eigen-solves."""
 
     def __init__(self, model: object, track: str | None) -> None:
-        self.at = _speed_function(model, track)
+        resolved = _resolve(model, track)
+        self.at = lambda S: resolved.at(speed=S)
         self.solves = 0
+        self.groups, self.main = getattr(resolved, "groups", None), getattr(resolved, "main_body", None)
 
     def roots(self, speed: float) -> np.ndarray:
         self.solves += 1
@@ -136,7 +144,7 @@ class CriticalSpeed:
     frequency : float
         Hunting frequency |Im s|/2π of the critical root, Hz (nan when stable over the range).
     mode : str
-        Coordinate with the largest amplitude in the critical root's eigenvector ("" if none).
+        Name of the critical mode (:func:`mode_name`, e.g. "body hunting", "bogie_front hunting"; "" if none).
     eigen_solves : int
         Number of eigenvalue problems solved.
     bracket : tuple of float
@@ -145,6 +153,8 @@ class CriticalSpeed:
         True when a root already has Re s > 0 at the lowest speed of the range.
     tol : float
         Absolute speed tolerance, m/s.
+    coordinate : str
+        Coordinate with the largest amplitude in the critical root's eigenvector ("" if none).
     """
 
     speed: float
@@ -154,6 +164,7 @@ class CriticalSpeed:
     bracket: tuple[float, float]
     unstable_at_lower_end: bool
     tol: float
+    coordinate: str = ""
 
     @property
     def stable_over_range(self) -> bool:
@@ -162,6 +173,7 @@ class CriticalSpeed:
     def to_pandas(self) -> pd.DataFrame:
         """One row: every field, the bracket as ``bracket_low``, ``bracket_high`` (m/s)."""
         return pd.DataFrame([{"speed": self.speed, "frequency_hz": self.frequency, "mode": self.mode,
+                              "coordinate": self.coordinate,
                               "eigen_solves": self.eigen_solves, "bracket_low": self.bracket[0],
                               "bracket_high": self.bracket[1], "unstable_at_lower_end": self.unstable_at_lower_end,
                               "stable_over_range": self.stable_over_range, "tol": self.tol}])
@@ -221,12 +233,12 @@ def critical_speed(
     counted = _Counted(model, track)
     found, bracket = first_crossing(counted, lo, hi, tol, int(grid))
     if found == lo and bracket == (lo, lo):
-        f, mode = _critical_root(counted, lo)
-        return CriticalSpeed(lo, f, mode, counted.solves, (lo, lo), True, tol)
+        f, mode, coordinate = _critical_root(counted, lo)
+        return CriticalSpeed(lo, f, mode, counted.solves, (lo, lo), True, tol, coordinate)
     if math.isinf(found):
         return CriticalSpeed(math.inf, math.nan, "", counted.solves, bracket, False, tol)
-    f, mode = _critical_root(counted, bracket[1])
-    return CriticalSpeed(found, f, mode, counted.solves, bracket, False, tol)
+    f, mode, coordinate = _critical_root(counted, bracket[1])
+    return CriticalSpeed(found, f, mode, counted.solves, bracket, False, tol, coordinate)
 
 
 def first_crossing(a, lo: float, hi: float, tol: float, grid: int) -> tuple[float, tuple[float, float]]:
@@ -260,14 +272,17 @@ def _refine(a, left: float, right: float, tol: float) -> tuple[float, tuple[floa
     return float(root), (float(max(root - tol, left)), float(min(root + tol, right)))
 
 
-def _critical_root(counted: _Counted, speed: float) -> tuple[float, str]:
+def _critical_root(counted: _Counted, speed: float) -> tuple[float, str, str]:
+    """Frequency (Hz), mode name and largest-amplitude coordinate of the least stable root at ``speed``."""
     counted.solves += 1
     system = counted.at(speed)
     m = system.modal()
     n = system.n
     real = np.where(np.abs(m.s) > NEUTRAL_ROOT * np.max(np.abs(m.s)), m.s.real, -np.inf)
     j = int(np.argmax(real))
-    return float(abs(m.s[j].imag)) / (2.0 * math.pi), system.names[int(np.argmax(np.abs(m.V[:n, j])))]
+    zeta = -m.s[j].real / abs(m.s[j])
+    name, _, _ = mode_name(system.names, _shares(system, m.V[:n, j]), zeta, counted.groups, counted.main)
+    return (float(abs(m.s[j].imag)) / (2.0 * math.pi), name, system.names[int(np.argmax(np.abs(m.V[:n, j])))])
 
 
 def least_damping(model: object, speeds: Sequence[float], track: str | None = None) -> float:
@@ -279,3 +294,182 @@ def least_damping(model: object, speeds: Sequence[float], track: str | None = No
         live = s[np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s))]
         worst = min(worst, float(np.min(-live.real / np.abs(live))))
     return worst
+
+
+# ---------------------------------------------------------------------------------------------- modes
+MOTIONS = {"u": "longitudinal", "v": "lateral", "w": "bounce", "alpha": "roll", "beta": "pitch", "gamma": "yaw"}
+HUNTING_DAMPING = 0.3  # a hunting mode is oscillatory and lightly damped (heavily creep-damped sway is not hunting)
+HUNTING_COUPLING = 0.05  # share of the energy a body mode must give to its trucks (running gear) to be body hunting
+HUNTING_LATERAL = 0.3  # share of a truck group's energy in lateral motion for truck hunting
+
+
+def _body_dof(name: str) -> tuple[str, str]:
+    body, _, dof = name.rpartition(".")
+    return (body, dof) if body else (name, "")
+
+
+def _track_body(body: str) -> bool:
+    return body.endswith("_track") or body == "track"
+
+
+def _shares(system: LinearSystem, vector: np.ndarray) -> np.ndarray:
+    """Each coordinate's share of the modal kinetic energy Re(v̄_i (M v)_i) / vᴴMv (sums to 1)."""
+    e = np.real(np.conj(vector) * (system.M @ vector))
+    total = float(np.sum(e))
+    return e / total if total > 0 else np.full(len(e), 1.0 / len(e))
+
+
+def mode_name(names: Sequence[str], shares: np.ndarray, damping_ratio: float,
+              groups: Mapping[str, str] | None = None, main: str | None = None) -> tuple[str, str, float]:
+    """Name of a mode from the coordinates' shares of its kinetic energy: ``(name, group, its share)``.
+
+    Bodies are gathered into groups (``groups``: body → group, e.g. a truck frame with its wheelsets and
+    motors; a vehicle view provides them; default: each body its own group).  The group with the largest
+    share dominates; a mode dominated by lumped track bodies is "track".  Its motion is the kind of
+    coordinate with the largest share within the group ("lateral", "yaw", "roll", "bounce", "pitch").
+    A lightly damped (ζ < 0.3) mode is *hunting* when the main body (``main``, the car body) dominates in a
+    lateral, yaw or roll motion and gives at least 5 % of the energy to the running gear ("body hunting": the
+    kinematic motion of the trucks coupled to the body's lower sway), or when a truck group (or the only body
+    of a one-body vehicle) dominates with at least 30 % of its energy in lateral motion ("<truck> hunting").
+    """
+    groups = dict(groups or {})
+    per_group: dict[str, float] = {}
+    per_kind: dict[tuple[str, str], float] = {}
+    for name, share in zip(names, shares, strict=True):
+        body, dof = _body_dof(name)
+        group = "track" if _track_body(body) else groups.get(body, body)
+        per_group[group] = per_group.get(group, 0.0) + share
+        kind = MOTIONS.get(dof, dof or body)
+        per_kind[(group, kind)] = per_kind.get((group, kind), 0.0) + share
+    if per_group.get("track", 0.0) > 0.5:
+        return "track", "track", per_group["track"]
+    group = max((g for g in per_group if g != "track"), key=per_group.get)
+    own = {k: v for (g, k), v in per_kind.items() if g == group}
+    total = max(sum(own.values()), 1e-300)
+    motion = max(own, key=own.get)
+    if damping_ratio < HUNTING_DAMPING and main is not None:
+        running_gear = sum(v for g, v in per_group.items() if g not in (main, "track"))
+        if group == main and running_gear >= HUNTING_COUPLING and motion in ("lateral", "yaw", "roll"):
+            motion = "hunting"
+        elif (group != main or len(per_group) == 1) and own.get("lateral", 0.0) >= HUNTING_LATERAL * total:
+            motion = "hunting"  # a truck group; or a vehicle of one body (a single wheelset)
+    if not motion or motion == group:
+        return group, group, per_group[group]
+    return f"{group} {motion}", group, per_group[group]
+
+
+def modes(model: LinearSystem | object, speed: float | None = None, track: str | None = None,
+          groups: Mapping[str, str] | None = None) -> pd.DataFrame:
+    """The modes of a system (or of a model at ``speed``, m/s), one row per mode in ascending frequency.
+
+    Columns: ``frequency_hz`` (|Im s|/2π), ``damping_ratio`` (−Re s/|s|), ``real`` (1/s), ``imag`` (rad/s),
+    ``name`` (:func:`mode_name`: e.g. "body lateral", "body hunting", "bogie_front hunting",
+    "wheelset3 lateral", "track"), ``group`` (the dominant body or group), ``share`` (its share of the modal
+    kinetic energy), ``track_share`` (the share of lumped track bodies).  Neutral rigid-body roots (s ≈ 0)
+    are named "rigid body".  ``groups`` (body → group) default to the model's own ``groups`` (a vehicle
+    view has them: each truck frame with its wheelsets and motors; the car body is its first body).
+    """
+    if groups is None:
+        groups = getattr(model, "groups", None)
+    main = getattr(model, "main_body", None)
+    system = model if isinstance(model, LinearSystem) else _speed_function(model, track)(speed)
+    m = system.modal()
+    n = system.n
+    scale = float(np.max(np.abs(m.s)))
+    rows = []
+    for k in mode_order(m.s)[1::2]:
+        s = m.s[k]
+        shares = _shares(system, m.V[:n, k])
+        mag = abs(s)
+        zeta = -s.real / mag if mag else 1.0
+        if mag <= NEUTRAL_ROOT * scale:
+            name, group, share = "rigid body", _body_dof(system.names[int(np.argmax(shares))])[0], float(np.max(shares))
+        else:
+            name, group, share = mode_name(system.names, shares, zeta, groups, main)
+        track_share = float(sum(v for c, v in zip(system.names, shares, strict=True) if _track_body(_body_dof(c)[0])))
+        rows.append({"frequency_hz": abs(s.imag) / (2 * math.pi), "damping_ratio": zeta, "real": s.real,
+                     "imag": abs(s.imag), "name": name, "group": group, "share": share, "track_share": track_share})
+    return pd.DataFrame(rows)
+
+
+# ---------------------------------------------------------------------------------------------- design constraints
+def _family_rows(family, p, speeds: Sequence[float], exclude: Sequence[str]):
+    """Per speed: the member, its roots one per mode (mode order) and a mask of the kept (vehicle) modes."""
+    groups, main = getattr(family, "groups", None), getattr(family, "main_body", None)
+    for S in _speeds(speeds):
+        system = family.at(p, speed=float(S))
+        m = system.modal()
+        idx = mode_order(m.s)[1::2]
+        scale = float(np.max(np.abs(m.s)))
+        keep = np.ones(len(idx), dtype=bool)
+        n = system.n
+        for j, k in enumerate(idx):
+            if abs(m.s[k]) <= NEUTRAL_ROOT * scale:
+                keep[j] = False
+                continue
+            zeta = -m.s[k].real / abs(m.s[k])
+            name, group, _ = mode_name(system.names, _shares(system, m.V[:n, k]), zeta, groups, main)
+            if name == "track" or any(x == name or x == group or name.startswith(x) for x in exclude):
+                keep[j] = False
+        yield float(S), system, idx, keep
+
+
+def root_constraints(family, p: Sequence[float] | None, speeds: Sequence[float], sigma_min: float = 0.0,
+                     exclude: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
+    """Stability constraint rows ``g = Re s_j(p, S_k) + σ_min ≤ 0`` for every mode j at every speed S_k (SPEC §2.5).
+
+    One row per mode (n per speed, mode order), so the count is fixed as the design changes; a neutral root,
+    a track mode (lumped track bodies carry most of its energy) or a mode named in ``exclude`` (a name, a body
+    or a name prefix) gets the constant row −1 with a zero gradient.  Returns ``(g (K·n,), dg/dp (K·n, P))``,
+    1/s.  ``family`` is a ParametricSystem with a speed term; ``p`` its parameters (None: its values).
+    """
+    sigma_min = number("sigma_min", sigma_min, non_negative=True)
+    values, jac = [], []
+    for _, system, idx, keep in _family_rows(family, p, speeds, exclude):
+        ds = root_jacobian(system)[idx]
+        s = system.modal().s[idx]
+        values.append(np.where(keep, s.real + sigma_min, -1.0))
+        jac.append(np.where(keep[:, None], ds.real, 0.0))
+    return np.concatenate(values), np.vstack(jac)
+
+
+def damping_constraints(family, p: Sequence[float] | None, speeds: Sequence[float], zeta_min: float,
+                        exclude: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
+    """Rows ``g = ζ_min − ζ_j(p, S_k) ≤ 0``: every vehicle mode at least ``ζ_min`` damped at every speed (SPEC §2.5).
+
+    Conventions as :func:`root_constraints` (excluded rows −1); ζ = −Re s/|s| with
+    dζ/dp from the root derivatives.  Returns ``(g (K·n,), dg/dp (K·n, P))``.
+    """
+    zeta_min = number("zeta_min", zeta_min)
+    values, jac = [], []
+    for _, system, idx, keep in _family_rows(family, p, speeds, exclude):
+        s = system.modal().s[idx]
+        dzeta = damping_ratio_jacobian(s, root_jacobian(system)[idx])
+        values.append(np.where(keep, zeta_min + s.real / np.abs(s), -1.0))
+        jac.append(np.where(keep[:, None], -dzeta, 0.0))
+    return np.concatenate(values), np.vstack(jac)
+
+
+def critical_speed_gradient(family, p: Sequence[float] | None = None, speed_range: tuple[float, float] = (1.0, 100.0),
+                            tol: float = 1e-6, grid: int = 8) -> tuple[CriticalSpeed, np.ndarray]:
+    """The critical speed of ``family`` at ``p`` and its gradient ``dVc/dp`` (P,), m/s per parameter unit.
+
+    By the implicit-function theorem at the crossing, ``dVc/dp = −(∂Re s/∂p)/(∂Re s/∂S)`` for the critical
+    root s (SPEC §2.5).  The gradient is zero when the family is stable over the range (or unstable at its
+    lower end): there the critical speed does not move with a small change of p.  Note that the lowest
+    crossing can switch from one mode to another as p changes: Vc(p) is then continuous but not smooth, which
+    is why per-root constraints over a speed grid (:func:`root_constraints`) are the smooth formulation.
+    """
+    member = family if p is None else family.with_values(p)
+    cs = critical_speed(member, speed_range=speed_range, tol=tol, grid=grid)
+    grad = np.zeros(len(family.parameters))
+    if cs.stable_over_range or cs.unstable_at_lower_end:
+        return cs, grad
+    system = member.at(speed=cs.speed)
+    s = system.modal().s
+    live = np.where(np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s)), s.real, -np.inf)
+    k = int(np.argmax(live))
+    d_speed = float(root_speed_derivative(system)[k].real)
+    if d_speed == 0.0:
+        return cs, grad
+    return cs, -root_jacobian(system)[k].real / d_speed

@@ -30,6 +30,7 @@ import numpy as np
 import pandas as pd
 
 from railopt.models.forcing import DistanceForcing, Forcing
+from railopt.models.modal import growing_roots
 from railopt.models.system import RESPONSE_ORDER, LinearSystem
 from railopt.models.validation import frequencies_rad_s
 from railopt.models.vehicle.irregularity import Irregularity, RailInput, wavelength_m
@@ -130,8 +131,9 @@ def _frequencies(frequencies_hz) -> np.ndarray:
     return f
 
 
-def _solve(system: LinearSystem, f: np.ndarray, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
-    """Output values (N, outputs) and the relative residuals ‖Z X − F‖∞ / ‖F‖∞ (N,) by direct solves."""
+def _solve(system: LinearSystem, f: np.ndarray, names: list[str]) -> tuple[np.ndarray, np.ndarray, bool]:
+    """Output values (N, outputs), the relative residuals ‖Z X − F‖∞ / ‖F‖∞ (N,) by direct solves, and whether a
+    steady state exists (no root with Re s > 0)."""
     w = 2 * np.pi * f
     with np.errstate(over="ignore", invalid="ignore"):
         Z = system.K[None] - w[:, None, None] ** 2 * system.M[None] + 1j * w[:, None, None] * system.C[None]
@@ -147,7 +149,7 @@ def _solve(system: LinearSystem, f: np.ndarray, names: list[str]) -> tuple[np.nd
         o = system.outputs[name]
         feed = o.feedthrough_values(w) if o.feedthrough is not None else 0.0
         Y[:, j] = (X @ o.row + feed) * (1j * w) ** o.order
-    return Y, np.max(np.abs(R), axis=1) / scale
+    return Y, np.max(np.abs(R), axis=1) / scale, growing_roots(system.eigenvalues()).size == 0
 
 
 def frequency_response(view: VehicleView, frequencies_hz: Sequence[float] | np.ndarray,
@@ -158,7 +160,9 @@ def frequency_response(view: VehicleView, frequencies_hz: Sequence[float] | np.n
     Returns a DataFrame with one row per (output, frequency): ``frequency_hz``, ``wavelength_m``
     (= S/f), ``output``, ``quantity``, ``unit``, ``amplitude`` (≥ 0, per the irregularity's
     amplitude as given), ``phase_deg`` (relative to the profile at the leading axle), ``real``,
-    ``imag``, ``residual`` (‖Z X − F‖∞/‖F‖∞ of the solve), ``track``, ``speed_m_s``, ``input``.
+    ``imag``, ``residual`` (‖Z X − F‖∞/‖F‖∞ of the solve), ``track``, ``speed_m_s``, ``input``,
+    ``steady_state`` (False where a root has Re s > 0 at that speed: the amplitude is then the formal
+    Z⁻¹F, not a response the vehicle reaches — it hunts).
     The view's speed is used unless the irregularity fixes its wavelength (then S = f L per row).
 
     Raises
@@ -177,11 +181,13 @@ def frequency_response(view: VehicleView, frequencies_hz: Sequence[float] | np.n
         speed = f * input.wavelength_m
         parts = [_solve(family.at(speed=float(s)), f[i:i + 1], names) for i, s in enumerate(speed)]
         Y, residual = np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+        steady = np.array([p[2] for p in parts])
     else:
         if view.speed is None:
             raise ValueError("speed: this view has no forward speed; use .at_speed(S) with S in m/s")
         speed = np.full(len(f), view.speed)
-        Y, residual = _solve(family.at(), f, names)
+        Y, residual, stable = _solve(family.at(), f, names)
+        steady = np.full(len(f), stable)
     label = input.label if isinstance(input, Irregularity | RailInput) else str(input)
     frames = []
     for j, r in enumerate(rows):
@@ -190,7 +196,7 @@ def frequency_response(view: VehicleView, frequencies_hz: Sequence[float] | np.n
             "frequency_hz": f, "wavelength_m": wavelength_m(f, speed), "output": r.name,
             "quantity": quantity, "unit": r.unit + UNIT_SUFFIX[quantity], "amplitude": np.abs(y),
             "phase_deg": np.degrees(np.angle(y)), "real": y.real, "imag": y.imag, "residual": residual,
-            "track": view.track, "speed_m_s": speed, "input": label,
+            "track": view.track, "speed_m_s": speed, "input": label, "steady_state": steady,
         }))
     return pd.concat(frames, ignore_index=True)
 

@@ -266,7 +266,31 @@ class Vehicle:
             bodies=tuple(BodyPlace(b.name, b.kind, b.cg) for b in a.bodies),
             wheelsets=tuple((b.name, float(b.cg[0])) for b in self.wheelsets()),
             semi_gauge=None if wr is None else wr.e0, block_dofs=dofs,
+            groups=self.mode_groups(), main_body=self.bodies[0].name,
         )
+
+    def mode_groups(self) -> dict[str, str]:
+        """Body -> group for mode names: the car body (first body) alone; each body suspended from it (a truck
+        frame) with every body reached from that frame without passing the car body (its wheelsets, motors)."""
+        main = self.bodies[0].name
+        links: dict[str, set[str]] = {b.name: set() for b in self.bodies}
+        pairs = [(e.body_a, e.body_b) for e in self.elements] + [(c.body, c.to) for c in self.constraints if c.to]
+        for a, b in pairs:
+            if a in links and b in links:
+                links[a].add(b)
+                links[b].add(a)
+        groups = {main: main}
+        frontier = sorted(links[main] - {main})
+        groups.update({f: f for f in frontier})
+        while frontier:
+            reached = []
+            for f in frontier:
+                for b in sorted(links[f]):
+                    if b not in groups:
+                        groups[b] = groups[f]
+                        reached.append(b)
+            frontier = reached
+        return groups
 
     def _cab_rows(self, a: Assembly, T: np.ndarray) -> dict[str, np.ndarray]:
         """Displacement rows of the cab point (carried by the first body) in x, y, z."""

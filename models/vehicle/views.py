@@ -92,6 +92,11 @@ class VehicleView:
         e0 (m) of the contact, for cross-level inputs.
     block_dofs : tuple of str
         The body coordinates this block spans (e.g. ``("v", "alpha", "gamma")``).
+    groups : dict
+        Body -> group for mode names: each truck frame (a body suspended from the car body) with the wheelsets
+        and motors reached from it; lumped track bodies -> "track".
+    main_body : str
+        The car body (the file's first body).
     """
 
     name: str
@@ -119,6 +124,8 @@ class VehicleView:
     wheelsets: tuple[tuple[str, float], ...] = ()
     semi_gauge: float | None = None
     block_dofs: tuple[str, ...] = ()
+    groups: dict[str, str] = field(default_factory=dict)
+    main_body: str | None = None
 
     def __repr__(self) -> str:
         speed = "no speed" if self.speed is None else f"S={self.speed:g} m/s"
@@ -216,7 +223,8 @@ class VehicleView:
             specs = output_specs(self, outputs, quantity, input)
         return ParametricSystem(self.M, base["C"], base["K"], F0, parts=parts, names=self.coordinates, outputs=specs,
                                 C_speed=self.C_creep, F_speed=F_speed,
-                                values=[self.values[k] for k in ids], speed=self.speed)
+                                values=[self.values[k] for k in ids], speed=self.speed,
+                                groups=self.groups, main_body=self.main_body)
 
     @cached_property
     def _free(self) -> ParametricSystem:

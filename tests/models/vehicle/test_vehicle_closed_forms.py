@@ -95,7 +95,8 @@ def test_single_wheelset_critical_speed_routh_hurwitz(params: dict) -> None:
     assert not cs.unstable_at_lower_end
     assert abs(cs.speed - exact_speed) / exact_speed < 1e-6
     assert abs(cs.frequency - exact_freq) / exact_freq < 1e-6
-    assert cs.mode in ("wheelset.v", "wheelset.gamma")
+    assert cs.coordinate in ("wheelset.v", "wheelset.gamma")
+    assert cs.mode == "wheelset hunting"
 
 
 def test_flexible_track_converges_to_rigid() -> None:

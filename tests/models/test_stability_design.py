@@ -1,0 +1,150 @@
+"""Stability as a design quantity (issue 14, SPEC §2.4–2.5): no steady state for an unstable system,
+root and critical-speed gradients against central differences and the Routh–Hurwitz closed form, mode names."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from railopt.models import ParameterPart, ParametricSystem
+from railopt.models.sensitivity import root_jacobian, root_speed_derivative
+from railopt.models.stability import (
+    critical_speed,
+    critical_speed_gradient,
+    damping_constraints,
+    modes,
+    root_constraints,
+)
+from railopt.models.vehicle import Irregularity, load_vehicle
+
+from conftest import routh_hurwitz
+
+WHEELSET = dict(m=1500.0, iz=700.0, ky=1e6, kpsi=2e6, f11=10e6, f22=9e6, lam=0.1, e0=0.75, r0=0.45)
+
+
+def wheelset_family(m, iz, ky, kpsi, f11, f22, lam, e0, r0) -> ParametricSystem:
+    return ParametricSystem(
+        np.diag([m, iz]), np.zeros((2, 2)), np.array([[0.0, -2 * f22], [2 * f11 * e0 * lam / r0, 0.0]]),
+        parts={"ky": ParameterPart(K=np.diag([1.0, 0.0])), "kpsi": ParameterPart(K=np.diag([0.0, 1.0]))},
+        C_speed=np.diag([2 * f22, 2 * f11 * e0**2]), values=[ky, kpsi], names=("wheelset.v", "wheelset.gamma"))
+
+
+def matched(s_ref: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """``s`` reordered to the nearest root of ``s_ref`` (FD steps move roots a little)."""
+    return np.array([s[np.argmin(np.abs(s - r))] for r in s_ref])
+
+
+def test_an_unstable_system_has_no_certified_maximum() -> None:
+    """The coach above its critical speed: no steady state, so no number is certified (issue 14 finding 2)."""
+    system = load_vehicle("manchester-coach").lateral("rigid", 100.0).forced_system(
+        Irregularity("alignment", amplitude_m=0.001), ["cab.lateral"], quantity="acceleration")
+    for exact in (True, False):
+        rm = system.response_maxima((1.2566, 62.83), exact=exact)
+        assert not rm.certified
+        assert rm.value == np.inf and np.all(np.isinf(rm.values))
+        assert rm.reason.startswith("unstable: root s = 3.04") and "no steady-state response" in rm.reason
+    assert system.peak((1.2566, 62.83)) == np.inf
+    table = load_vehicle("manchester-coach").lateral("rigid", 100.0).frequency_response(
+        [1.0, 2.0], Irregularity("alignment", amplitude_m=0.001), ["cab.lateral"])
+    assert not table["steady_state"].any()
+    stable = load_vehicle("manchester-coach").lateral("rigid", 50.0).frequency_response(
+        [1.0, 2.0], Irregularity("alignment", amplitude_m=0.001), ["cab.lateral"])
+    assert stable["steady_state"].all()
+
+
+@pytest.mark.parametrize("vehicle", ["sd40-2", "single-wheelset"])
+def test_root_and_speed_derivatives_equal_central_differences(vehicle: str) -> None:
+    view = load_vehicle(vehicle).lateral("rigid")
+    names = list(view.parts)
+    family = view.family(names)
+    p0, S = family.values, 25.0
+    system = family.at(p0, speed=S)
+    s0 = system.modal().s
+    keep = np.abs(s0) > 1e-6 * np.max(np.abs(s0))
+    J = root_jacobian(system)
+    for i in range(len(names)):
+        h = 1e-4 * max(abs(p0[i]), 1.0)  # central differences: truncation ~1e-8, rounding of the roots ~1e-12
+        up, down = p0.copy(), p0.copy()
+        up[i] += h
+        down[i] -= h
+        fd = (matched(s0, family.at(up, speed=S).eigenvalues()) - matched(s0, family.at(down, speed=S).eigenvalues()))
+        fd /= 2 * h
+        scale = np.max(np.abs(fd[keep])) + 1e-12
+        assert np.max(np.abs(J[keep, i] - fd[keep])) <= 1e-6 * scale, names[i]
+    dS = root_speed_derivative(system)
+    h = 1e-5 * S
+    fd = (matched(s0, family.at(p0, speed=S + h).eigenvalues()) - matched(s0, family.at(p0, speed=S - h).eigenvalues()))
+    fd /= 2 * h
+    assert np.max(np.abs(dS[keep] - fd[keep])) <= 1e-6 * np.max(np.abs(fd[keep]))
+
+
+def test_critical_speed_gradient_equals_the_routh_hurwitz_derivative() -> None:
+    family = wheelset_family(**WHEELSET)
+    cs, grad = critical_speed_gradient(family, speed_range=(1.0, 200.0), tol=1e-9)
+    assert cs.speed == pytest.approx(routh_hurwitz(**WHEELSET)[0], rel=1e-9)
+    for i, name in enumerate(("ky", "kpsi")):
+        h = 1e-5 * WHEELSET[name]
+        exact = (routh_hurwitz(**(WHEELSET | {name: WHEELSET[name] + h}))[0]
+                 - routh_hurwitz(**(WHEELSET | {name: WHEELSET[name] - h}))[0]) / (2 * h)
+        assert grad[i] == pytest.approx(exact, rel=1e-6)
+
+
+def test_critical_speed_gradient_of_the_locomotive_equals_central_differences() -> None:
+    view = load_vehicle("sd40-2").lateral("rigid")
+    names = ["K2", "K3", "C13", "C15"]
+    family = view.family(names)
+    p0 = family.values
+    cs, grad = critical_speed_gradient(family, speed_range=(5.0, 60.0), tol=1e-10, grid=12)
+    assert 30.0 < cs.speed < 40.0
+    for i in range(len(names)):
+        h = 1e-4 * p0[i]
+        up, down = p0.copy(), p0.copy()
+        up[i] += h
+        down[i] -= h
+        vu = critical_speed(family.with_values(up), speed_range=(5.0, 60.0), tol=1e-11, grid=12).speed
+        vd = critical_speed(family.with_values(down), speed_range=(5.0, 60.0), tol=1e-11, grid=12).speed
+        fd = (vu - vd) / (2 * h)
+        assert grad[i] == pytest.approx(fd, rel=1e-6, abs=1e-6 * np.max(np.abs(grad))), names[i]
+
+
+@pytest.mark.parametrize("rows", [root_constraints, damping_constraints])
+def test_stability_constraint_rows_and_their_gradients(rows) -> None:
+    family = load_vehicle("sd40-2").lateral("flexible").family(["K2", "C13"])
+    speeds = [10.0, 25.0]
+    kwargs = {"sigma_min": 0.05} if rows is root_constraints else {"zeta_min": 0.05}
+    p0 = family.values
+    g, J = rows(family, p0, speeds, **kwargs)
+    assert len(g) == 2 * family.n  # one row per mode and speed: the count is fixed
+    # track modes (lumped track bodies carry their energy) are excluded rows
+    table = modes(family, speed=10.0)
+    assert (table["name"] == "track").sum() >= 6
+    assert np.sum(g[: family.n] == -1.0) >= (table["name"] == "track").sum()
+    for i in range(2):
+        h = 1e-6 * p0[i]
+        up, down = p0.copy(), p0.copy()
+        up[i] += h
+        down[i] -= h
+        fd = (rows(family, up, speeds, **kwargs)[0] - rows(family, down, speeds, **kwargs)[0]) / (2 * h)
+        live = g != -1.0
+        assert np.max(np.abs(J[live, i] - fd[live])) <= 1e-5 * np.max(np.abs(fd[live]))
+
+
+@pytest.mark.parametrize(("vehicle", "conicity", "expected"), [
+    ("manchester-coach", 0.025, "body hunting"),
+    ("manchester-coach", 0.05, "bogie_front hunting"),
+    ("sd40-2", None, "body hunting"),
+])
+@pytest.mark.parametrize("track", ["rigid", "flexible"])
+def test_the_critical_mode_is_named_by_what_hunts(vehicle: str, conicity, expected: str, track: str) -> None:
+    v = load_vehicle(vehicle)
+    if conicity is not None:
+        v = v.with_parameters({"conicity": conicity})
+    cs = critical_speed(v, track, (1.0, 150.0), tol=0.01)
+    assert cs.mode == expected
+    table = modes(v.lateral(track), speed=cs.speed)
+    critical = table.loc[table["real"].idxmax()]
+    assert critical["name"] == expected
+    assert critical["frequency_hz"] == pytest.approx(cs.frequency, rel=1e-3)
+    if track == "flexible":
+        assert (table["name"] == "track").sum() == len(v.wheelsets())  # one track roll per wheelset
+        assert table.loc[table["name"] == "track", "track_share"].min() > 0.9
