@@ -1,0 +1,3 @@
+"""railopt.studies: study kinds driven by TOML, the model catalog, the model → design adapter, the CLI."""
+
+__all__: list[str] = []

@@ -31,10 +31,14 @@ from railopt.design import MinimaxProblem, dask_client, multistart
 from railopt.models import LinearSystem
 from railopt.models.stability import critical_speed
 from railopt.models.tmd import nishihara_asami
+from railopt.models.units import INCH, RAD_PER_HZ
 from railopt.models.vehicle import load_vehicle
 from railopt.studies.config import load_study
 from railopt.studies.kinds.campaign import campaign_problem
-from railopt.studies.report import markdown_table
+from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.writer import Writer
+
+__all__ = ["random_chain", "run_bench"]
 
 STUDIES = Path(__file__).resolve().parent
 
@@ -110,7 +114,7 @@ def _cab_rows(repeat: int) -> list[dict]:
     names = [v.name for v in config.design.variables]
     x0 = np.array([setup.named_designs["existing"][n] for n in names])
     p, _ = setup.parameters(names, x0)
-    cab = setup.system.at(p)
+    cab = setup.family.at(p)
     band = config.objective.target(setup, exact=True).band
     reps = max(repeat // 4, 5)
     t_floor = _floor(cab, band, reps)
@@ -126,8 +130,8 @@ def _cab_rows(repeat: int) -> list[dict]:
     from railopt.models.vehicle.irregularity import Irregularity
 
     lateral = load_vehicle("sd40-2").lateral("rigid", speed=20.0)
-    full = lateral.forced_system(Irregularity("alignment", 0.25 * 0.0254), ["cab.lateral"], quantity="acceleration")
-    fband = (0.1 * 2 * np.pi, 3.0 * 2 * np.pi)
+    full = lateral.forced_system(Irregularity("alignment", 0.25 * INCH), ["cab.lateral"], quantity="acceleration")
+    fband = (0.1 * RAD_PER_HZ, 3.0 * RAD_PER_HZ)
     t_ff = _floor(full, fband, reps)
     t_ft = _median_time(lambda: _fresh(full).response_maxima(fband), reps)
     t_fe = _median_time(lambda: _fresh(full).response_maxima(fband, exact=True), reps)
@@ -163,7 +167,7 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
     mu = 0.05
     _, config, _ = load_study(STUDIES / "tmd_hinf.toml")
     setup = config.setups()["mu0.05"]
-    ps = setup.system
+    ps = setup.family
     band = config.objective.target(setup, exact=True).band
     na = nishihara_asami(mu)
     p, _ = setup.parameters(["tuning", "damping_ratio"], np.array([na.tuning, na.damping_ratio]))
@@ -263,8 +267,7 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
     rows += _cab_rows(repeat)
 
     table = pd.DataFrame(rows, columns=["benchmark", "ours_s", "reference_s", "ratio", "reference", "note"])
-    out.mkdir(parents=True, exist_ok=True)
-    table.to_csv(out / "bench.csv", index=False)
+    Writer(out).table(table, "bench")
     header = (f"# railopt bench\n\nMachine: {platform.machine()}, {os.cpu_count()} CPUs, Python "
               f"{platform.python_version()}, {platform.system()}; repeat={repeat}. Times are medians in seconds; "
               "ratio = ours / reference (below 1 is faster).\n\n")

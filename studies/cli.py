@@ -3,7 +3,7 @@
 ``railopt run studies/<name>.toml [--workers N] [--scheduler ADDR] [--resume]`` validates the
 config (errors name the field, exit code 2, nothing written), takes the study's lock, runs the
 study into a staging folder, and swaps it in as ``results/<name>/`` only when the run succeeds
-(see :mod:`railopt.studies.publish`).  Every failure a user can cause — a bad config, a damaged
+(see :mod:`railopt.studies.output.publish`).  Every failure a user can cause — a bad config, a damaged
 store, a results folder that cannot be written, a busy study, an unreachable scheduler — ends as
 one line on stderr naming the file, field or address, and exit code 2.
 """
@@ -20,9 +20,10 @@ from pathlib import Path
 
 from railopt import __version__
 from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV, scheduler_timeout
-from railopt.studies.base import StudyContext
 from railopt.studies.config import ConfigError, load_study
-from railopt.studies.publish import (
+from railopt.studies.kind import StudyContext
+from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.publish import (
     CAMPAIGNS,
     ResultsError,
     carry_stores,
@@ -33,7 +34,9 @@ from railopt.studies.publish import (
     staging_path,
     study_lock,
 )
-from railopt.studies.report import markdown_table
+from railopt.studies.output.writer import Writer
+
+__all__ = ["STUDIES_DIR", "build_parser", "main", "resolve_study"]
 
 STUDIES_DIR = Path(__file__).resolve().parent
 EXIT_USAGE = 2
@@ -84,7 +87,6 @@ def cmd_run(args: argparse.Namespace) -> int:
         clear_leftovers(results, name)
         staging = ensure_folder(staging_path(results, name))
         context = StudyContext(
-            outdir=staging,
             store_dir=staging if args.fresh else final,  # --fresh: old stores go only when this run is published
             workers=args.workers,
             scheduler=args.scheduler,
@@ -93,18 +95,19 @@ def cmd_run(args: argparse.Namespace) -> int:
             show_progress=not args.no_progress,
         )
         try:
-            outcome = kind.run(config, context)
-            (staging / "summary.md").write_text(outcome.markdown)
+            result = kind.compute(config, context)
+            writer = Writer(staging)
+            (staging / "summary.md").write_text(kind.report(result, writer))
             shutil.copyfile(study_file, staging / "study.toml")
             if not args.fresh:
                 carry_stores(final, staging)
             publish(staging, final)
         finally:
             shutil.rmtree(staging, ignore_errors=True)
-    with_pd_options = outcome.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")
+    with_pd_options = result.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")
     print(f"\n{name}: {kind.summary}\n")
     print(with_pd_options)
-    print(f"\nwritten to {final}/ ({', '.join(['summary.md', *outcome.files])})")
+    print(f"\nwritten to {final}/ ({', '.join(['summary.md', *writer.files])})")
     return 0
 
 

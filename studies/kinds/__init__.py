@@ -1,1 +1,3 @@
-"""Study kinds; each module registers its kind with :func:`railopt.studies.base.register_kind`."""
+"""Study kinds; each module (or package) registers its kind with :func:`railopt.studies.kind.register_kind`."""
+
+__all__: list[str] = []

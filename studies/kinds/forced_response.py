@@ -16,23 +16,28 @@ reached by the speed S = f L (the models' speeds unused); its peaks are grid max
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from typing import ClassVar, Literal
 
 import numpy as np
 import pandas as pd
 from pydantic import Field, model_validator
-from scipy.optimize import minimize_scalar
 
 from railopt.models import all_response_maxima
+from railopt.models.peak_search import grid_maximum
 from railopt.models.stability import spectral_abscissa
-from railopt.studies.base import BandHz, FiniteModel, StudyContext, StudyKind, StudyOutcome, register_kind
+from railopt.models.units import FOOT, INCH, MPH
+from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.catalog import ModelsStudy, require_unique
-from railopt.studies.figures import plot_forced_response
-from railopt.studies.models import VehicleForcedOptions, vehicle_forced_model
-from railopt.studies.report import markdown_table, write_table
+from railopt.studies.catalog.vehicle import VehicleForcedOptions, vehicle_forced_model
+from railopt.studies.config import BandHz, FiniteModel
+from railopt.studies.kind import StudyContext, StudyKind, register_kind
+from railopt.studies.output.figures import plot_forced_response
+from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.writer import Writer
 
-HZ = 2 * np.pi
+__all__ = ["BandSpec", "ForcedResponseConfig", "ForcedResult", "GroupSpec", "PanelSpec", "compute", "report"]
+
 TRACKS = ("rigid", "flexible")
 
 
@@ -96,20 +101,13 @@ class ForcedResponseConfig(ModelsStudy):
                 opts = self.models[labels.index(label)].validated_options(f"models[{labels.index(label)}]")
                 if opts.track != track:
                     raise ValueError(f"groups[{gi}].{key}: model {label!r} is on {opts.track} track")
-                model, irregularity = _model(opts, f"groups[{gi}].{key}")
+                _, model, irregularity = _model(opts, f"groups[{gi}].{key}")
                 for pi, p in enumerate(g.panels):
                     try:
                         model.forced_system(irregularity, [p.output], p.quantity)
                     except ValueError as exc:
                         raise ValueError(f"groups[{gi}].panels[{pi}].output: {exc}") from None
         return self
-
-
-def _vehicle(options: VehicleForcedOptions):
-    from railopt.models.vehicle import load_vehicle
-
-    vehicle = load_vehicle(options.vehicle)
-    return vehicle.with_parameters(options.parameters) if options.parameters else vehicle
 
 
 def _model(options: VehicleForcedOptions, where: str):
@@ -124,84 +122,154 @@ def _grid(band: BandSpec) -> np.ndarray:
     return np.geomspace(lo, hi, band.points) if band.spacing == "log" else np.linspace(lo, hi, band.points)
 
 
-def run(config: ForcedResponseConfig, context: StudyContext) -> StudyOutcome:
-    cfg = config
+@dataclass
+class _Group:
+    """What one group computes: responses per (track, band, output), peaks, modes, checks, figures."""
+
+    responses: dict = field(default_factory=dict)
+    peak_at: dict = field(default_factory=dict)
+    peaks: list[dict] = field(default_factory=list)
+    modes: list[dict] = field(default_factory=list)
+    checks: list[str] = field(default_factory=list)
+    tracks: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """One panel figure: rigid and flexible series of one output over one band."""
+
+    name: str
+    group: str
+    panel: PanelSpec
+    band: str
+    series: dict
+    title: str
+    peaks: dict
+    note: str
+    log_frequency: bool
+
+
+@dataclass(frozen=True)
+class ForcedResult:
+    """FRFs (``frf``), the peaks with the flexible/rigid ratio (``table``), modes, checks and figure specs."""
+
+    config: ForcedResponseConfig
+    frf: pd.DataFrame
+    table: pd.DataFrame
+    modes: pd.DataFrame
+    figures: list[FigureSpec]
+    checks: list[str]
+    tracks: list
+
+
+def _group_models(cfg: ForcedResponseConfig, gi: int, g: GroupSpec) -> dict:
+    """track -> (label, options, vehicle, view, irregularity) of one group."""
     refs = {m.label: m for m in cfg.models}
-    curves, peaks, modes, files, figures, tracks = [], [], [], [], [], []
-    checks: list[str] = []
+    models = {}
+    for track in TRACKS:
+        label = getattr(g, track)
+        opts = refs[label].validated_options(f"groups[{gi}].{track}")
+        models[track] = (label, opts, *_model(opts, f"groups[{gi}].{track}"))
+    return models
+
+
+def _band_peaks(model, sys, irregularity, b: BandSpec, outputs: list[str], quantity: str, out: _Group,
+                track: str) -> dict:
+    """output -> (peak, frequency in Hz, certified): certified band maxima of ``sys``, or (fixed wavelength,
+    no one system) grid maxima refined by the shared peak search."""
+    if sys is not None:
+        maxima = all_response_maxima(sys, (b.band_hz[0] * HZ, b.band_hz[1] * HZ), exact=True, outputs=outputs)
+        return {o: (rm.value, rm.argmax_frequency / HZ, rm.certified) for o, rm in maxima.items()}
+    return {o: (*_grid_peak(model, irregularity, o, quantity, out.responses[(track, b.label, o)]), False)
+            for o in outputs}
+
+
+def _track_responses(cfg: ForcedResponseConfig, g: GroupSpec, track: str, entry: tuple, out: _Group) -> None:
+    """Responses and peaks of every panel output of one track's model, one system per quantity."""
+    label, opts, vehicle, model, irregularity = entry
+    if g.wavelength_m is not None:
+        irregularity = replace(irregularity, wavelength_m=g.wavelength_m)
+        out.checks += _stability_over_speeds(label, model, g)
+    by_quantity: dict[str, list[PanelSpec]] = {}
+    for p in g.panels:
+        by_quantity.setdefault(p.quantity, []).append(p)
+    sys = None
+    for quantity, panels in by_quantity.items():
+        outputs = [p.output for p in panels]
+        sys = None
+        if g.wavelength_m is None:  # one LinearSystem per (track, quantity): its outputs share one eigen-decomposition
+            sys = model.forced_system(irregularity, outputs, quantity)
+            if not sys.is_stable(tol=1e-8 * float(np.max(np.abs(sys.eigenvalues())))):
+                out.checks.append(f"{label}: a root has Re s > 0 at {opts.speed_m_s:g} m/s — no steady state")
+        for b in g.bands:
+            df = model.frequency_response(_grid(b), irregularity, outputs, quantity)
+            worst = float(df["residual"].max())
+            if worst > 1e-10:
+                out.checks.append(f"{label} {b.label}: residual of Z X = F up to {worst:.2e}")
+            for o, d in df.groupby("output", sort=False):
+                out.responses[(track, b.label, o)] = d
+            found = _band_peaks(model, sys, irregularity, b, outputs, quantity, out, track)
+            for p in panels:
+                value, f_peak, certified = found[p.output]
+                out.peak_at[(track, b.label, p.output)] = (value, f_peak)
+                unit = out.responses[(track, b.label, p.output)]["unit"].iloc[0]
+                out.peaks.append({"group": g.label, "band": b.label, "figure": p.figure, "output": p.output,
+                                  "quantity": quantity, "unit": unit, "track": track, "peak": value,
+                                  "frequency_hz": f_peak, "certified": certified})
+    if track == "flexible" and sys is not None:
+        out.modes += _modes(g.label, label, model, sys, cfg.track_mode_min_hz)
+        out.tracks.append((g.label, vehicle.lumped_track()))
+
+
+def _curves_and_figures(g: GroupSpec, models: dict, out: _Group) -> tuple[list[pd.DataFrame], list[FigureSpec]]:
+    """Rigid and flexible columns side by side per (panel, band), and the figure of each plotted band."""
+    curves, figures = [], []
+    for p in g.panels:
+        for b in g.bands:
+            rows = {t: out.responses[(t, b.label, p.output)] for t in TRACKS}
+            curves.append(pd.DataFrame({
+                "group": g.label, "band": b.label, "output": p.output, "unit": rows["rigid"]["unit"].to_numpy(),
+                "frequency_hz": rows["rigid"]["frequency_hz"].to_numpy(),
+                "wavelength_m": rows["rigid"]["wavelength_m"].to_numpy(),
+                **{f"{t}_{c}": rows[t][c].to_numpy() for t in TRACKS for c in ("amplitude", "phase_deg")},
+            }))
+            if b.plot:
+                figures.append(FigureSpec(f"{g.label}_{_slug(p.output)}_{b.label}", g.label, p, b.label, rows,
+                                          f"{p.figure} {p.title}".strip(),
+                                          {t: out.peak_at[(t, b.label, p.output)] for t in TRACKS},
+                                          _note(models, b, g), b.spacing == "log"))
+    return curves, figures
+
+
+def compute(config: ForcedResponseConfig, context: StudyContext) -> ForcedResult:
+    cfg = config
+    curves, figures, groups = [], [], []
     for gi, g in enumerate(cfg.groups):
-        models = {}
-        for track in TRACKS:
-            label = getattr(g, track)
-            opts = refs[label].validated_options(f"groups[{gi}].{track}")
-            models[track] = (label, opts, *_model(opts, f"groups[{gi}].{track}"))
-        # one LinearSystem per (track, quantity): all panel outputs share its eigen-decomposition
-        by_quantity: dict[str, list[PanelSpec]] = {}
-        for p in g.panels:
-            by_quantity.setdefault(p.quantity, []).append(p)
-        responses: dict[tuple[str, str, str], pd.DataFrame] = {}
-        peak_at: dict[tuple[str, str, str], tuple[float, float]] = {}
-        for track, (label, opts, model, irregularity) in models.items():
-            if g.wavelength_m is not None:
-                irregularity = replace(irregularity, wavelength_m=g.wavelength_m)
-                checks += _stability_over_speeds(label, model, g)
-            for quantity, panels in by_quantity.items():
-                outputs = [p.output for p in panels]
-                sys = None
-                if g.wavelength_m is None:
-                    sys = model.forced_system(irregularity, outputs, quantity)
-                    if not sys.is_stable(tol=1e-8 * float(np.max(np.abs(sys.eigenvalues())))):
-                        checks.append(f"{label}: a root has Re s > 0 at {opts.speed_m_s:g} m/s — no steady state")
-                for b in g.bands:
-                    df = model.frequency_response(_grid(b), irregularity, outputs, quantity)
-                    worst = float(df["residual"].max())
-                    if worst > 1e-10:
-                        checks.append(f"{label} {b.label}: residual of Z X = F up to {worst:.2e}")
-                    for o, d in df.groupby("output", sort=False):
-                        responses[(track, b.label, o)] = d
-                    if sys is not None:
-                        maxima = all_response_maxima(sys, (b.band_hz[0] * HZ, b.band_hz[1] * HZ), exact=True,
-                                                     outputs=outputs)
-                        found = {o: (rm.value, rm.argmax_frequency / HZ, rm.certified) for o, rm in maxima.items()}
-                    else:
-                        found = {o: (*_grid_peak(model, irregularity, o, quantity, responses[(track, b.label, o)]),
-                                     False) for o in outputs}
-                    for p in panels:
-                        value, f_peak, certified = found[p.output]
-                        peak_at[(track, b.label, p.output)] = (value, f_peak)
-                        unit = responses[(track, b.label, p.output)]["unit"].iloc[0]
-                        peaks.append({"group": g.label, "band": b.label, "figure": p.figure, "output": p.output,
-                                      "quantity": quantity, "unit": unit, "track": track, "peak": value,
-                                      "frequency_hz": f_peak, "certified": certified})
-            if track == "flexible" and sys is not None:
-                modes += _modes(g.label, label, model, sys, cfg.track_mode_min_hz)
-                tracks.append((g.label, _vehicle(opts).lumped_track()))
-        for p in g.panels:
-            for b in g.bands:
-                rows = {t: responses[(t, b.label, p.output)] for t in TRACKS}
-                curves.append(pd.DataFrame({
-                    "group": g.label, "band": b.label, "output": p.output, "unit": rows["rigid"]["unit"].to_numpy(),
-                    "frequency_hz": rows["rigid"]["frequency_hz"].to_numpy(),
-                    "wavelength_m": rows["rigid"]["wavelength_m"].to_numpy(),
-                    **{f"{t}_{c}": rows[t][c].to_numpy() for t in TRACKS for c in ("amplitude", "phase_deg")},
-                }))
-                if not b.plot:
-                    continue
-                fig = plot_forced_response(rows, title=f"{p.figure} {p.title}".strip(),
-                                           peaks={t: peak_at[(t, b.label, p.output)] for t in TRACKS},
-                                           note=_note(models, b, g), log_frequency=b.spacing == "log")
-                name = f"{g.label}_{_slug(p.output)}_{b.label}.png"
-                fig.savefig(context.outdir / name, dpi=cfg.dpi)
-                files.append(name)
-                figures.append((g.label, p, b.label, name))
-    frf = pd.concat(curves, ignore_index=True)
-    table = _ratios(pd.DataFrame(peaks))
-    mode_table = pd.DataFrame(modes)
-    files += _write(frf, context, "frf") + write_table(table, context.outdir, "peaks")
-    if not mode_table.empty:
-        files += write_table(mode_table, context.outdir, "modes")
-    md = _summary(cfg, table, mode_table, frf, figures, checks, tracks)
-    return StudyOutcome(table=table, markdown=md, files=files)
+        models = _group_models(cfg, gi, g)
+        out = _Group()
+        for track, entry in models.items():
+            _track_responses(cfg, g, track, entry, out)
+        c, f = _curves_and_figures(g, models, out)
+        curves += c
+        figures += f
+        groups.append(out)
+    return ForcedResult(cfg, pd.concat(curves, ignore_index=True),
+                        _ratios(pd.DataFrame([r for o in groups for r in o.peaks])),
+                        pd.DataFrame([r for o in groups for r in o.modes]), figures,
+                        [c for o in groups for c in o.checks], [t for o in groups for t in o.tracks])
+
+
+def report(result: ForcedResult, writer: Writer) -> str:
+    cfg = result.config
+    for f in result.figures:
+        fig = plot_forced_response(f.series, title=f.title, peaks=f.peaks, note=f.note, log_frequency=f.log_frequency)
+        writer.figure(fig, f.name, dpi=cfg.dpi)
+    writer.table(result.frf, "frf")
+    writer.table(result.table, "peaks")
+    if not result.modes.empty:
+        writer.table(result.modes, "modes")
+    figures = [(f.group, f.panel, f.band, f"{f.name}.png") for f in result.figures]
+    return _summary(cfg, result.table, result.modes, result.frf, figures, result.checks, result.tracks)
 
 
 def _modes(group: str, label: str, model, sys, min_hz: float) -> list[dict]:
@@ -217,41 +285,30 @@ def _modes(group: str, label: str, model, sys, min_hz: float) -> list[dict]:
     return sorted(out, key=lambda r: r["frequency_hz"])
 
 
-def _write(df: pd.DataFrame, context: StudyContext, stem: str) -> list[str]:
-    context.outdir.mkdir(parents=True, exist_ok=True)
-    df.to_csv(context.outdir / f"{stem}.csv", index=False, float_format="%.5g")
-    return [f"{stem}.csv"]
-
-
 def _slug(output: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in output).strip("_")
 
 
 def _note(models: dict, band: BandSpec, group: GroupSpec) -> str:
-    _, opts, _, irr = models["rigid"]
+    _, opts, _, _, irr = models["rigid"]
     lo, hi = band.band_hz
     if group.wavelength_m is not None:
         L = group.wavelength_m
         return (f"{opts.vehicle}, {opts.view} model; {irr.kind} a = {irr.amplitude_m:g} m per rail, {irr.rails}; "
-                f"fixed L = {L:.4g} m, S = f L = {lo * L:.3g}–{hi * L:.3g} m/s ({hi * L / 0.44704:.0f} mph)")
+                f"fixed L = {L:.4g} m, S = f L = {lo * L:.3g}–{hi * L:.3g} m/s ({hi * L / MPH:.0f} mph)")
     return (f"{opts.vehicle}, {opts.view} model, S = {opts.speed_m_s:g} m/s; {irr.label} per rail; "
             f"f = S/L (L = {opts.speed_m_s / hi:.3g}–{opts.speed_m_s / lo:.3g} m)")
 
 
 def _grid_peak(model, irregularity, output: str, quantity: str, df: pd.DataFrame) -> tuple[float, float]:
-    """Largest sample of a fixed-wavelength sweep refined by bounded Brent between its neighbours."""
+    """Largest sample of a fixed-wavelength sweep refined between its neighbours (the shared peak search)."""
     f = df["frequency_hz"].to_numpy()
-    a = df["amplitude"].to_numpy()
-    k = int(np.argmax(a))
-    lo, hi = f[max(k - 1, 0)], f[min(k + 1, len(f) - 1)]
-    if hi <= lo:
-        return float(a[k]), float(f[k])
 
-    def amplitude(x: float) -> float:
-        return float(model.frequency_response([x], irregularity, [output], quantity)["amplitude"].iloc[0])
+    def amplitude(x: np.ndarray) -> np.ndarray:
+        return model.frequency_response(np.atleast_1d(x), irregularity, [output], quantity)["amplitude"].to_numpy()
 
-    r = minimize_scalar(lambda x: -amplitude(x), bounds=(lo, hi), method="bounded", options={"xatol": 1e-9 * hi})
-    return (float(-r.fun), float(r.x)) if -r.fun > a[k] else (float(a[k]), float(f[k]))
+    f_peak, value = grid_maximum(amplitude, f, df["amplitude"].to_numpy())
+    return value, f_peak
 
 
 def _stability_over_speeds(label: str, model, group: GroupSpec) -> list[str]:
@@ -307,12 +364,12 @@ def _summary(cfg: ForcedResponseConfig, table: pd.DataFrame, modes: pd.DataFrame
     lines += ["## Models", ""]
     for label, o in refs.items():
         lines.append(f"* `{label}`: {o.vehicle}, {o.view} block, {o.track} track, S = {o.speed_m_s:g} m/s "
-                     f"({o.speed_m_s / 0.44704:.1f} mph), {o.input.kind} irregularity, amplitude "
-                     f"{o.input.amplitude_m:g} m per rail ({o.input.amplitude_m / 0.0254:.3g} in)")
+                     f"({o.speed_m_s / MPH:.1f} mph), {o.input.kind} irregularity, amplitude "
+                     f"{o.input.amplitude_m:g} m per rail ({o.input.amplitude_m / INCH:.3g} in)")
     for g in cfg.groups:
         if g.wavelength_m is not None:
             lines.append(f"* group `{g.label}`: the thesis's sweep — fixed wavelength L = {g.wavelength_m:g} m "
-                         f"({g.wavelength_m / 0.3048:.3g} ft), each frequency f run at S = f L (the models' speeds "
+                         f"({g.wavelength_m / FOOT:.3g} ft), each frequency f run at S = f L (the models' speeds "
                          "unused)")
     lines += ["", "A frequency f at speed S is the wavelength L = S/f; each axle sees the profile delayed by its "
               "distance behind the leading axle over S.  Amplitudes are the responses to the irregularity "
@@ -363,6 +420,7 @@ def _summary(cfg: ForcedResponseConfig, table: pd.DataFrame, modes: pd.DataFrame
 KIND = register_kind(StudyKind(
     name="forced_response",
     config_model=ForcedResponseConfig,
-    run=run,
+    compute=compute,
+    report=report,
     summary="vehicle responses to sinusoidal rail irregularities, rigid vs flexible track (Figs 4.5–4.12)",
 ))

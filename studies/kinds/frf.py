@@ -8,6 +8,7 @@ and where it lies (``peaks.csv``, the exact option of (4.71)–(4.73)), and one 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 import numpy as np
@@ -15,19 +16,15 @@ import pandas as pd
 from pydantic import Field, model_validator
 
 from railopt.models import all_response_maxima
-from railopt.studies.base import (
-    BandHz,
-    FiniteModel,
-    StudyContext,
-    StudyKind,
-    StudyOutcome,
-    register_kind,
-)
+from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
-from railopt.studies.figures import plot_frf_panels
-from railopt.studies.report import markdown_table, write_table
+from railopt.studies.config import BandHz, FiniteModel
+from railopt.studies.kind import StudyContext, StudyKind, register_kind
+from railopt.studies.output.figures import plot_frf_panels
+from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.writer import Writer
 
-HZ = 2 * np.pi
+__all__ = ["DesignSpec", "FRFResult", "FRFStudyConfig", "GridSpec", "compute", "report"]
 
 
 class DesignSpec(FiniteModel):
@@ -85,54 +82,77 @@ class FRFStudyConfig(ModelsStudy):
             for j, d in enumerate(self.designs):
                 values = d.resolve(setup, f"designs[{j}]")
                 setup.parameters(list(values), np.array(list(values.values())))
-            bad = [o for o in self.outputs if o not in setup.system.output_names]
+            bad = [o for o in self.outputs if o not in setup.family.output_names]
             if bad:
-                known = list(setup.system.output_names)
+                known = list(setup.family.output_names)
                 raise ValueError(f"outputs: {bad} are not outputs of models[{i}]; it has {known}")
         return self
 
 
-def run(config: FRFStudyConfig, context: StudyContext) -> StudyOutcome:
+@dataclass(frozen=True)
+class FRFResult:
+    """|H| and phase on the grid (``frf``), the certified peaks (``table``) and the figure panels."""
+
+    config: FRFStudyConfig
+    frf: pd.DataFrame
+    table: pd.DataFrame
+    panels: list
+
+
+def _model_curves(cfg: FRFStudyConfig, i: int, ref, f_hz: np.ndarray, band: tuple[float, float]):
+    """Curves, peak rows and figure panels of one model at every design."""
+    setup = ref.setup(f"models[{i}]")
+    outputs = cfg.outputs or list(setup.family.output_names)
+    curves, peaks = [], []
+    panel_curves: dict[str, list] = {o: [] for o in outputs}
+    for j, d in enumerate(cfg.designs):
+        values = d.resolve(setup, f"designs[{j}]")
+        p, _ = setup.parameters(list(values), np.array(list(values.values())))
+        sys = setup.family.at(p)
+        H = sys.frf_outputs(f_hz * HZ)
+        maxima = all_response_maxima(sys, band, exact=True, outputs=outputs)
+        for o in outputs:
+            h = H[:, sys.output_index(o)]
+            curves.append(pd.DataFrame({"model": ref.label, "design": d.label, "output": o, "frequency_hz": f_hz,
+                                        "amplitude": np.abs(h), "phase_deg": np.degrees(np.angle(h))}))
+            rm = maxima[o]
+            peaks.append({"model": ref.label, "design": d.label, "output": o, "peak": rm.value,
+                          "frequency_hz": rm.argmax_frequency / HZ, "certified": rm.certified,
+                          "grid_points": rm.grid_points, "evaluation": rm.evaluation})
+            panel_curves[o].append((f"{d.label} (peak {rm.value:.6g} at {rm.argmax_frequency / HZ:.4g} Hz)",
+                                    f_hz, np.abs(h), f"C{j}"))
+    panels = [(f"{ref.label}: {setup.description}", f"|H| of {o}", c) for o, c in panel_curves.items()]
+    return curves, peaks, panels
+
+
+def compute(config: FRFStudyConfig, context: StudyContext) -> FRFResult:
     cfg = config
     f_hz = cfg.grid.frequencies_hz()
     band = (cfg.grid.band_hz[0] * HZ, cfg.grid.band_hz[1] * HZ)
     curves, peaks, panels = [], [], []
     for i, ref in enumerate(cfg.models):
-        setup = ref.setup(f"models[{i}]")
-        outputs = cfg.outputs or list(setup.system.output_names)
-        panel_curves: dict[str, list] = {o: [] for o in outputs}
-        for j, d in enumerate(cfg.designs):
-            values = d.resolve(setup, f"designs[{j}]")
-            p, _ = setup.parameters(list(values), np.array(list(values.values())))
-            sys = setup.system.at(p)
-            H = sys.frf_outputs(f_hz * HZ)
-            maxima = all_response_maxima(sys, band, exact=True, outputs=outputs)
-            for o in outputs:
-                h = H[:, sys.output_index(o)]
-                curves.append(pd.DataFrame({"model": ref.label, "design": d.label, "output": o, "frequency_hz": f_hz,
-                                            "amplitude": np.abs(h), "phase_deg": np.degrees(np.angle(h))}))
-                rm = maxima[o]
-                peaks.append({"model": ref.label, "design": d.label, "output": o, "peak": rm.value,
-                              "frequency_hz": rm.argmax_frequency / HZ, "certified": rm.certified,
-                              "grid_points": rm.grid_points, "evaluation": rm.evaluation})
-                panel_curves[o].append((f"{d.label} (peak {rm.value:.6g} at {rm.argmax_frequency / HZ:.4g} Hz)",
-                                        f_hz, np.abs(h), f"C{j}"))
-        panels += [(f"{ref.label}: {setup.description}", f"|H| of {o}", c) for o, c in panel_curves.items()]
-    frf = pd.concat(curves, ignore_index=True)
-    peak_table = pd.DataFrame(peaks)
-    files = write_table(frf, context.outdir, "frf") + write_table(peak_table, context.outdir, "peaks")
-    fig = plot_frf_panels(panels)
-    fig.savefig(context.outdir / "frf.png", dpi=cfg.dpi)
-    files.append("frf.png")
-    md = "\n".join([f"# {cfg.study.name}", "", cfg.study.description, "",
-                    f"Band {cfg.grid.band_hz[0]:g}–{cfg.grid.band_hz[1]:g} Hz; `peak` is the certified band maximum "
-                    "(exact option of (4.71)–(4.73)).", "", markdown_table(peak_table), "", "![FRF](frf.png)", ""])
-    return StudyOutcome(table=peak_table, markdown=md, files=files)
+        c, p, pn = _model_curves(cfg, i, ref, f_hz, band)
+        curves += c
+        peaks += p
+        panels += pn
+    return FRFResult(cfg, pd.concat(curves, ignore_index=True), pd.DataFrame(peaks), panels)
+
+
+def report(result: FRFResult, writer: Writer) -> str:
+    cfg = result.config
+    writer.table(result.frf, "frf")
+    writer.table(result.table, "peaks")
+    writer.figure(plot_frf_panels(result.panels), "frf", dpi=cfg.dpi)
+    return "\n".join([f"# {cfg.study.name}", "", cfg.study.description, "",
+                      f"Band {cfg.grid.band_hz[0]:g}–{cfg.grid.band_hz[1]:g} Hz; `peak` is the certified band "
+                      "maximum (exact option of (4.71)–(4.73)).", "", markdown_table(result.table), "",
+                      "![FRF](frf.png)", ""])
 
 
 KIND = register_kind(StudyKind(
     name="frf",
     config_model=FRFStudyConfig,
-    run=run,
+    compute=compute,
+    report=report,
     summary="frequency responses and certified band maxima of catalogued models at given designs",
 ))

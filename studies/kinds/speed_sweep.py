@@ -10,6 +10,7 @@ critical-speed search with one vehicle parameter scaled by each factor.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
@@ -17,19 +18,17 @@ import pandas as pd
 from pydantic import Field, field_validator, model_validator
 
 from railopt.models.stability import critical_speed, root_locus
-from railopt.studies.base import (
-    FiniteModel,
-    Interval,
-    StudyContext,
-    StudyKind,
-    StudyOutcome,
-    register_kind,
-)
+from railopt.models.units import MPH
 from railopt.studies.catalog import ModelRef, ModelSetup, ModelsStudy
-from railopt.studies.figures import plot_root_locus
-from railopt.studies.report import markdown_table, write_table
+from railopt.studies.catalog.vehicle import load
+from railopt.studies.config import FiniteModel, Interval
+from railopt.studies.kind import StudyContext, StudyKind, register_kind
+from railopt.studies.output.figures import plot_root_locus
+from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.writer import Writer
 
-MPH = 0.44704
+__all__ = ["CriticalSpec", "SensitivitySpec", "SpeedGrid", "SpeedSweepConfig", "SpeedSweepResult", "compute",
+           "report"]
 
 
 class SpeedGrid(FiniteModel):
@@ -77,7 +76,7 @@ class SpeedSweepConfig(ModelsStudy):
     def _resolve(self) -> SpeedSweepConfig:
         for i, ref in enumerate(self.models):
             setup = ref.setup(f"models[{i}]")
-            if setup.speed_model is None:
+            if not setup.stability:
                 raise ValueError(f"models[{i}].model: {ref.model!r} has no forward speed; use a vehicle model")
             for j, sens in enumerate(self.sensitivity):
                 _variant(ref, sens.parameter, sens.factors[0], f"sensitivity[{j}]")
@@ -89,9 +88,7 @@ def _variant(ref: ModelRef, parameter: str, factor: float, where: str) -> ModelS
     options = ref.validated_options(where)
     if "parameters" not in type(options).model_fields:
         raise ValueError(f"{where}.parameter: model {ref.model!r} takes no parameter overrides")
-    from railopt.models.vehicle import load_vehicle
-
-    vehicle = load_vehicle(options.vehicle).with_parameters(options.parameters)
+    vehicle = load(options)
     try:
         base = vehicle.parameter(parameter)
     except ValueError as exc:
@@ -101,7 +98,7 @@ def _variant(ref: ModelRef, parameter: str, factor: float, where: str) -> ModelS
 
 
 def _critical_row(label: str, setup: ModelSetup, spec: CriticalSpec) -> dict:
-    cs = critical_speed(setup.speed_model(setup.defaults), speed_range=spec.range_m_s, tol=spec.tol_m_s,
+    cs = critical_speed(setup.stability_model(setup.defaults), speed_range=spec.range_m_s, tol=spec.tol_m_s,
                         grid=spec.points)
     return {"model": label, "critical_speed_m_s": cs.speed, "critical_speed_mph": cs.speed / MPH,
             "hunting_frequency_hz": cs.frequency, "mode": cs.mode, "eigen_solves": cs.eigen_solves,
@@ -109,51 +106,75 @@ def _critical_row(label: str, setup: ModelSetup, spec: CriticalSpec) -> dict:
             "tol_m_s": cs.tol}
 
 
-def run(config: SpeedSweepConfig, context: StudyContext) -> StudyOutcome:
+@dataclass(frozen=True)
+class SpeedSweepResult:
+    """Root loci, least damping per speed, critical speeds (``table``), sensitivities and the track effect."""
+
+    config: SpeedSweepConfig
+    locus: pd.DataFrame
+    damping: pd.DataFrame
+    table: pd.DataFrame
+    sensitivity: pd.DataFrame
+    track_effect: pd.DataFrame
+
+
+def _locus_and_damping(label: str, setup: ModelSetup, speeds: np.ndarray) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The root locus at the defaults and, per speed, its largest real part and least damping ratio."""
+    locus = root_locus(setup.stability_model(setup.defaults), speeds).to_pandas().assign(model=label)
+    g = locus.groupby("speed")
+    damping = pd.DataFrame({"model": label, "speed_m_s": g["real"].max().index,
+                            "spectral_abscissa": g["real"].max().to_numpy(),
+                            "least_damping_ratio": g["damping_ratio"].min().to_numpy()})
+    return locus, damping
+
+
+def _sensitivity_rows(cfg: SpeedSweepConfig, ref: ModelRef) -> list[dict]:
+    rows = []
+    for j, sens in enumerate(cfg.sensitivity):
+        for factor in sens.factors:
+            row = _critical_row(ref.label, _variant(ref, sens.parameter, factor, f"sensitivity[{j}]"), cfg.critical)
+            rows.append({"parameter": sens.parameter, "factor": factor, **row})
+    return rows
+
+
+def compute(config: SpeedSweepConfig, context: StudyContext) -> SpeedSweepResult:
     cfg = config
     loci, critical, damping, sens_rows = [], [], [], []
     for i, ref in enumerate(cfg.models):
         setup = ref.setup(f"models[{i}]")
-        model = setup.speed_model(setup.defaults)
-        locus = root_locus(model, cfg.speeds.speeds()).to_pandas().assign(model=ref.label)
+        locus, damp = _locus_and_damping(ref.label, setup, cfg.speeds.speeds())
         loci.append(locus)
-        g = locus.groupby("speed")
-        damping.append(pd.DataFrame({"model": ref.label, "speed_m_s": g["real"].max().index,
-                                     "spectral_abscissa": g["real"].max().to_numpy(),
-                                     "least_damping_ratio": g["damping_ratio"].min().to_numpy()}))
+        damping.append(damp)
         critical.append(_critical_row(ref.label, setup, cfg.critical))
-        for j, sens in enumerate(cfg.sensitivity):
-            for factor in sens.factors:
-                row = _critical_row(ref.label, _variant(ref, sens.parameter, factor, f"sensitivity[{j}]"),
-                                    cfg.critical)
-                sens_rows.append({"parameter": sens.parameter, "factor": factor, **row})
-    locus_table = pd.concat(loci, ignore_index=True)
+        sens_rows += _sensitivity_rows(cfg, ref)
     critical_table = pd.DataFrame(critical)
-    files = write_table(locus_table, context.outdir, "root_locus")
-    files += write_table(critical_table, context.outdir, "critical_speeds")
-    files += write_table(pd.concat(damping, ignore_index=True), context.outdir, "damping")
-    sens_table = pd.DataFrame(sens_rows)
+    return SpeedSweepResult(cfg, pd.concat(loci, ignore_index=True), pd.concat(damping, ignore_index=True),
+                            critical_table, pd.DataFrame(sens_rows), _track_effect(cfg, critical_table))
+
+
+def report(result: SpeedSweepResult, writer: Writer) -> str:
+    cfg, critical_table, sens_table, track_effect = result.config, result.table, result.sensitivity, result.track_effect
+    writer.table(result.locus, "root_locus")
+    writer.table(critical_table, "critical_speeds")
+    writer.table(result.damping, "damping")
     if len(sens_table):
-        files += write_table(sens_table, context.outdir, "sensitivity")
-    fig = plot_root_locus(locus_table, critical_table)
-    fig.savefig(context.outdir / "root_locus.png", dpi=cfg.dpi)
-    files.append("root_locus.png")
+        writer.table(sens_table, "sensitivity")
+    writer.figure(plot_root_locus(result.locus, critical_table), "root_locus", dpi=cfg.dpi)
     lines = [f"# {cfg.study.name}", "", cfg.study.description, "",
              f"Root locus over {cfg.speeds.range_m_s[0]:g}–{cfg.speeds.range_m_s[1]:g} m/s; critical speed searched "
              f"in {cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s to ±{cfg.critical.tol_m_s:g} m/s.",
              "", markdown_table(critical_table), ""]
-    track_effect = _track_effect(cfg, critical_table)
     if len(track_effect):
         lines += ["Flexible against rigid track (same vehicle and parameters):", "", markdown_table(track_effect), ""]
         lines += _track_effect_sentences(track_effect, sens_table)
-        files += write_table(track_effect, context.outdir, "track_effect")
+        writer.table(track_effect, "track_effect")
     if len(sens_table):
         pivot = sens_table.pivot_table(index=["parameter", "factor"], columns="model", values="critical_speed_m_s",
                                        sort=False).reset_index()
         lines += ["Critical speed (m/s) with one parameter scaled by `factor` (all columns in `sensitivity.csv`):",
                   "", markdown_table(pivot, digits=5), ""]
     lines += ["![root locus](root_locus.png)", ""]
-    return StudyOutcome(table=critical_table, markdown="\n".join(lines), files=files)
+    return "\n".join(lines)
 
 
 def _track_effect_sentences(effect: pd.DataFrame, sens: pd.DataFrame) -> list[str]:
@@ -196,6 +217,7 @@ def _track_effect(cfg: SpeedSweepConfig, critical: pd.DataFrame) -> pd.DataFrame
 KIND = register_kind(StudyKind(
     name="speed_sweep",
     config_model=SpeedSweepConfig,
-    run=run,
+    compute=compute,
+    report=report,
     summary="root locus, critical speed and sensitivities over forward speed",
 ))

@@ -1,15 +1,15 @@
 """Study kind ``track``: the track-dynamics figures of thesis Ch. 3 (Figs 3.3–3.9) and tables.
 
 A config names the track (SI keys with units in the name), the figures to draw and the grids of
-the amplification table.  ``run`` writes PNG figures and CSV tables into ``context.outdir`` and
-returns a summary table and markdown.
+the amplification table.  ``compute`` collects the tables and the figure specs (a plot function and its
+data) in order; ``report`` writes them and returns the summary markdown.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
-from pathlib import Path
+from dataclasses import dataclass, field
+from functools import partial
 from typing import Literal
 
 import numpy as np
@@ -32,9 +32,13 @@ from railopt.models.track import (
     transient,
 )
 from railopt.models.track.parameters import RAILS
-from railopt.models.units import INCH, MPH, POUND_FORCE, PSI
-from railopt.studies.base import StrictModel, StudyContext, StudyHeader, StudyKind, StudyOutcome, register_kind
-from railopt.studies.figures import Curve, plot_amplification, plot_profiles, plot_time_histories
+from railopt.models.units import INCH, MPH, POUND_FORCE, PSI, RAD_PER_HZ
+from railopt.studies.config import StrictModel, StudyHeader
+from railopt.studies.kind import StudyContext, StudyKind, register_kind
+from railopt.studies.output.figures import Curve, plot_amplification, plot_profiles, plot_time_histories
+from railopt.studies.output.writer import Writer
+
+__all__ = ["TrackResult", "TrackStudyConfig", "compute", "report"]
 
 FigureName = Literal[
     "fig3_3_impulse",
@@ -56,7 +60,7 @@ class TrackTable(StrictModel):
     rail: str = "132 RE"
     EI_N_m2: float = Field(gt=0, default_factory=lambda: RAILS["132 RE"].EI)
     k_N_m2: float = Field(gt=0, default=3000.0 * PSI)
-    m_kg_m: float = Field(gt=0, default=3000.0 * PSI / (2 * math.pi * 62.0) ** 2)
+    m_kg_m: float = Field(gt=0, default=3000.0 * PSI / (RAD_PER_HZ * 62.0) ** 2)
     P_N: float = Field(gt=0, default=30_000.0 * POUND_FORCE)
     contact_spacing_m: float = Field(gt=0, default=1.5)
     lumped_damping_ratio: float = Field(ge=0, default=0.1)
@@ -158,22 +162,24 @@ def _maxima_rows(sols: list, labels: list[str], figure: str) -> list[dict]:
     ]
 
 
-class _Writer:
-    def __init__(self, outdir: Path, dpi: int) -> None:
-        self.outdir = outdir
-        self.dpi = dpi
-        self.files: list[str] = []
+@dataclass
+class _Sections:
+    """Tables and figure specs (a plot function with its data, drawn by the report) in the order made."""
 
-    def figure(self, fig, name: str) -> None:
-        fig.savefig(self.outdir / f"{name}.png", dpi=self.dpi)
-        self.files.append(f"{name}.png")
+    items: list[tuple[str, str, object]] = field(default_factory=list)
+
+    def figure(self, spec: Callable[[], object], name: str) -> None:
+        self.items.append(("figure", name, spec))
 
     def table(self, df: pd.DataFrame, name: str) -> None:
-        df.to_csv(self.outdir / f"{name}.csv", index=False, float_format="%.9g")
-        self.files.append(f"{name}.csv")
+        self.items.append(("table", name, df))
+
+    @property
+    def files(self) -> list[str]:
+        return [f"{name}.png" if kind == "figure" else f"{name}.csv" for kind, name, _ in self.items]
 
 
-def _profiles_figure(cfg: TrackStudyConfig, out: _Writer, name: str, title: str, beams, labels, speeds):
+def _profiles_figure(cfg: TrackStudyConfig, out: _Sections, name: str, title: str, beams, labels, speeds):
     xi = np.linspace(-cfg.figures.half_length_m, cfg.figures.half_length_m, cfg.figures.points)
     P = cfg.track.P_N
     sols = [moving_load(b, xi, P, v) for b, v in zip(beams, speeds, strict=True)]
@@ -181,12 +187,12 @@ def _profiles_figure(cfg: TrackStudyConfig, out: _Writer, name: str, title: str,
     curves = [
         Curve(lab, s.xi, s.y, styles[i % 4]) for i, (s, lab) in enumerate(zip(sols, labels, strict=True))
     ]
-    out.figure(plot_profiles(curves, title, cfg.figures.units, _note(beams[0].with_(c=0.0, N=0.0), P)), name)
+    out.figure(partial(plot_profiles, curves, title, cfg.figures.units, _note(beams[0].with_(c=0.0, N=0.0), P)), name)
     out.table(_profile_table(sols, labels), name)
     return _maxima_rows(sols, labels, name)
 
 
-def _fig_impulse(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
+def _fig_impulse(cfg: TrackStudyConfig, beam: Beam, out: _Sections) -> dict:
     t = np.linspace(0.0, cfg.transient.impulse_end_omega0_t / beam.omega0, 301)
     I = cfg.transient.impulse_N_s  # noqa: E741
     exact = impulse_response_at_load(beam, t, I, method="closed")
@@ -200,7 +206,7 @@ def _fig_impulse(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
     ]
     note = _note(beam, cfg.track.P_N, f"impulse I = {I:g} N·s, no damping, no axial force")
     out.figure(
-        plot_time_histories(curves, "Fig 3.3 — response under q = I δ(x) δ(t)", cfg.figures.units, note=note),
+        partial(plot_time_histories, curves, "Fig 3.3 — response under q = I δ(x) δ(t)", cfg.figures.units, note=note),
         "fig3_3_impulse",
     )
     out.table(pd.DataFrame({"t_s": t, "y_exact_m": exact, "y_numerical_m": num}), "fig3_3_impulse")
@@ -211,14 +217,14 @@ def _fig_impulse(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
     }
 
 
-def _fig_step(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
+def _fig_step(cfg: TrackStudyConfig, beam: Beam, out: _Sections) -> dict:
     b = beam.with_(c=cfg.transient.step_damping_ratio * beam.critical_damping)
     t = np.linspace(0.0, cfg.transient.step_end_s, 501)
     P = cfg.track.P_N
     y = transient(b, [0.0], t, SuddenLoad(P)).y[:, 0]
     y_st = float(hetenyi_deflection(0.0, P, b.k, b.EI))
     note = _note(beam, P, f"damping ratio {b.damping_ratio:g}, no axial force")
-    fig = plot_time_histories(
+    fig = partial(plot_time_histories,
         [Curve("transient, case (i)", t, y, "-")],
         "Fig 3.4 — response to q = P δ(x) from rest",
         cfg.figures.units,
@@ -231,7 +237,7 @@ def _fig_step(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
     return {"step_final_rel_error": abs(y[-1] - y_st) / y_st}
 
 
-def _fig_accelerating(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
+def _fig_accelerating(cfg: TrackStudyConfig, beam: Beam, out: _Sections) -> dict:
     tr = cfg.transient
     b = beam.with_(c=tr.accel_damping_ratio * beam.critical_damping)
     v0 = tr.accel_speed_mph * MPH
@@ -247,18 +253,18 @@ def _fig_accelerating(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
     ]
     note = _note(beam, cfg.track.P_N, f"damping ratio {b.damping_ratio:g}")
     out.figure(
-        plot_profiles(curves, "Accelerating load vs constant-speed load", cfg.figures.units, note),
+        partial(plot_profiles, curves, "Accelerating load vs constant-speed load", cfg.figures.units, note),
         "accelerating",
     )
     out.table(pd.DataFrame({"xi_m": xi, "y_accelerating_m": y_acc, "y_steady_m": steady.y}), "accelerating")
     return {"accelerating_vs_steady_rel": float(np.max(np.abs(y_acc - steady.y)) / steady.y_max)}
 
 
-def _fig_oscillating(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
+def _fig_oscillating(cfg: TrackStudyConfig, beam: Beam, out: _Sections) -> dict:
     tr = cfg.transient
     b = beam.with_(c=tr.oscillating_damping_ratio * beam.critical_damping)
     v = tr.oscillating_speed_mph * MPH
-    Omega = 2 * math.pi * tr.oscillating_frequency_Hz
+    Omega = RAD_PER_HZ * tr.oscillating_frequency_Hz
     load = MovingLoad(cfg.track.P_N, v, Omega=Omega)
     times = np.linspace(0.0, tr.oscillating_time_s, 401)
     sol = transient(b, [v * tr.oscillating_time_s], times, load)
@@ -273,19 +279,28 @@ def _fig_oscillating(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
         f"({v / MPH:.0f} mph)"
     )
     note = _note(beam, cfg.track.P_N, f"damping ratio {b.damping_ratio:g}")
-    out.figure(plot_time_histories(curves, title, cfg.figures.units, note=note), "oscillating")
+    out.figure(partial(plot_time_histories, curves, title, cfg.figures.units, note=note), "oscillating")
     out.table(
         pd.DataFrame({"t_s": times, "y_oscillating_m": sol.y[:, 0], "y_constant_m": const}), "oscillating"
     )
     return {}
 
 
-def run(config: TrackStudyConfig, context: StudyContext) -> StudyOutcome:
-    """Draw the requested figures, write the CSV tables and return the summary."""
+@dataclass(frozen=True)
+class TrackResult:
+    """The summary quantities (``table``), the profile maxima and the figure and table sections."""
+
+    config: TrackStudyConfig
+    table: pd.DataFrame
+    summary: dict
+    maxima: list[dict]
+    sections: _Sections
+
+
+def compute(config: TrackStudyConfig, context: StudyContext) -> TrackResult:
+    """Compute the requested figures' data and the tables."""
     cfg = config
-    outdir = Path(context.outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    out = _Writer(outdir, cfg.figures.dpi)
+    out = _Sections()
     tk = cfg.track
     beam = Beam(EI=tk.EI_N_m2, m=tk.m_kg_m, k=tk.k_N_m2)
     lt = lumped(beam, tk.lumped_damping_ratio, contact_spacing=tk.contact_spacing_m)
@@ -325,11 +340,20 @@ def run(config: TrackStudyConfig, context: StudyContext) -> StudyOutcome:
         out.table(pd.DataFrame(maxima), "maxima")
     summary_df = pd.DataFrame([{"quantity": k, "value": v} for k, v in summary.items()])
     out.table(summary_df, "summary")
-    md = _markdown(cfg, summary, maxima, out.files)  # the CLI writes it as summary.md
-    return StudyOutcome(table=summary_df, markdown=md, files=out.files)
+    return TrackResult(cfg, summary_df, summary, maxima, out)
 
 
-def _amplification(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
+def report(result: TrackResult, writer: Writer) -> str:
+    """Draw the figures, write the tables (in the order computed) and return the summary markdown."""
+    for kind, name, item in result.sections.items:
+        if kind == "figure":
+            writer.figure(item(), name, dpi=result.config.figures.dpi)
+        else:
+            writer.table(item, name)
+    return _markdown(result.config, result.summary, result.maxima, result.sections.files)
+
+
+def _amplification(cfg: TrackStudyConfig, beam: Beam, out: _Sections) -> dict:
     """Dynamic-amplification table over v/v_cr, c/c_cr, N/N_cr and, when asked, its figure."""
     am, P = cfg.amplification, cfg.track.P_N
     table = dynamic_amplification(beam.EI, beam.m, beam.k, P, am.speed_ratios, am.damping_ratios, am.axial_ratios)
@@ -340,7 +364,7 @@ def _amplification(cfg: TrackStudyConfig, beam: Beam, out: _Writer) -> dict:
         theta = np.linspace(0.0, 1.6, 161)
         fine = dynamic_amplification(beam.EI, beam.m, beam.k, P, theta, [z for z in am.damping_ratios if z > 0], [0.0])
         curves = [(f"c/c_cr = {z:g}", g["speed_amplification"].to_numpy()) for z, g in fine.groupby("damping_ratio")]
-        out.figure(plot_amplification(theta, curves, "Dynamic amplification of the maximum deflection, N = 0"),
+        out.figure(partial(plot_amplification, theta, curves, "Dynamic amplification of the maximum deflection, N = 0"),
                    "amplification")
     return {}
 
@@ -438,6 +462,7 @@ def _markdown(cfg: TrackStudyConfig, s: dict, maxima: list[dict], files: list[st
 KIND = register_kind(StudyKind(
     name="track",
     config_model=TrackStudyConfig,
-    run=run,
+    compute=compute,
+    report=report,
     summary="Track beam on a Kelvin foundation: Figs 3.3–3.9, amplification, lumped track (thesis Ch. 3)",
 ))

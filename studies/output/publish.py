@@ -30,6 +30,20 @@ from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 from pathlib import Path
 
+__all__ = [
+    "CAMPAIGNS",
+    "ResultsError",
+    "StudyLocked",
+    "carry_stores",
+    "check_writable",
+    "clear_leftovers",
+    "ensure_folder",
+    "lock_path",
+    "publish",
+    "staging_path",
+    "study_lock",
+]
+
 CAMPAIGNS = "campaigns"
 
 

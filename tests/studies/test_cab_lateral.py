@@ -17,8 +17,9 @@ import pandas as pd
 import pytest
 
 from railopt.design import nondominated
+from railopt.models.units import INCH
 from railopt.models.vehicle import load_vehicle
-from railopt.models.vehicle.cab import INCH, CabInput, cab_lateral_model
+from railopt.models.vehicle.cab import CabInput, cab_lateral_model
 from railopt.studies.cli import STUDIES_DIR, main
 
 BAND = (0.0, 2 * math.pi * 3.0)
@@ -26,10 +27,10 @@ NAMES = ["secondary_lateral_stiffness", "sidebearer1_vertical_stiffness", "later
          "rotational_shock_absorber_damping"]  # the flagship's design variables (element aliases)
 
 
-def test_quasi_static_input_carries_the_body_with_it():
+def test_quasi_static_input_carries_the_body_with_it(sd40):
     """At Ω → 0 in the fixed-speed reading both trucks move together by the amplitude: the body follows
     rigidly (cab displacement = amplitude, no roll, no stroke)."""
-    cab = cab_lateral_model(load_vehicle("sd40-2"), CabInput(mode="fixed_speed"))
+    cab = cab_lateral_model(sd40, CabInput(mode="fixed_speed"))
     sys = cab.at()
     amp = 0.25 * INCH
     assert abs(sys.frf(0.0, "cab_displacement")) == pytest.approx(amp, rel=1e-9)
@@ -38,10 +39,10 @@ def test_quasi_static_input_carries_the_body_with_it():
         assert abs(sys.frf(0.0, f"secondary_stroke_{frame}")) < 1e-12 * amp
 
 
-def test_cut_equals_the_body_block_of_the_lateral_model():
+def test_cut_equals_the_body_block_of_the_lateral_model(sd40):
     """The cab model's M, K, C are the body rows/columns of the full lateral model (the body carries no
     creep), and its forcing is minus the body-frame coupling times the frame inputs."""
-    v = load_vehicle("sd40-2")
+    v = sd40
     lat = v.lateral("rigid", speed=30.0)
     body = [lat.coordinates.index(f"body.{d}") for d in ("v", "alpha", "gamma")]
     sys = v.cab_lateral(CabInput(mode="fixed_speed"))
@@ -55,8 +56,8 @@ def test_cut_equals_the_body_block_of_the_lateral_model():
     np.testing.assert_allclose(sys.forcing.value(0.0), expect, rtol=1e-12, atol=1e-9)
 
 
-def test_residual_and_certified_peaks_of_every_output():
-    sys = load_vehicle("sd40-2").cab_lateral()
+def test_residual_and_certified_peaks_of_every_output(sd40):
+    sys = sd40.cab_lateral()
     for w in np.linspace(0.0, BAND[1], 7):
         X = sys.solve(w)
         F = sys.forcing.value(w)

@@ -14,7 +14,7 @@ from railopt.models.tmd import den_hartog, nishihara_asami
 from railopt.studies.cli import STUDIES_DIR, main
 from railopt.studies.config import ConfigError, load_study
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 NEW_CAMPAIGN = """
 [study]

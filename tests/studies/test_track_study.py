@@ -7,10 +7,11 @@ import pandas as pd
 import pytest
 from pydantic import ValidationError
 
-from railopt.studies.base import StudyContext
+from railopt.studies.kind import StudyContext
 from railopt.studies.kinds.track import KIND, TrackStudyConfig
+from railopt.studies.output.writer import Writer
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize("name", ["track_moving_load", "track_transient"])
@@ -45,12 +46,13 @@ def test_run_writes_figures_tables_and_summary(tmp_path):
             },
         }
     )
-    outcome = KIND.run(cfg, StudyContext(outdir=tmp_path, store_dir=tmp_path))
+    result = KIND.compute(cfg, StudyContext(store_dir=tmp_path))
+    markdown = KIND.report(result, Writer(tmp_path))
     for f in ("fig3_5_damping.png", "fig3_4_step.png", "amplification.csv", "maxima.csv"):
         assert (tmp_path / f).exists()
-    summary = dict(zip(outcome.table["quantity"], outcome.table["value"], strict=True))
+    summary = dict(zip(result.table["quantity"], result.table["value"], strict=True))
     assert float(summary["f0_Hz"]) == pytest.approx(62.0, rel=1e-4)
-    assert "f0" in outcome.markdown
+    assert "f0" in markdown
     amp = pd.read_csv(tmp_path / "amplification.csv")
     resonant = amp[(amp.damping_ratio == 0.0) & (amp.speed_ratio == 1.0)]
     assert resonant["y_max_m"].iloc[0] == float("inf")

@@ -36,8 +36,8 @@ from faults_cli import (
     wait_until,
 )
 
-from railopt.studies import publish as publish_module
-from railopt.studies.publish import lock_path, publish
+from railopt.studies.output import publish as publish_module
+from railopt.studies.output.publish import lock_path, publish
 
 N_STARTS = 24  # + the Den Hartog start: ids 0..24; long enough (~2 s) to be killed in the middle
 IDS = list(range(N_STARTS + 1))
@@ -255,7 +255,7 @@ def test_sigterm_during_a_campaign_cleans_up_and_keeps_finished_starts(published
 HOLD = """
 import sys, time
 from pathlib import Path
-from railopt.studies.publish import study_lock
+from railopt.studies.output.publish import study_lock
 with study_lock(Path(sys.argv[1]), sys.argv[2]):
     print("held", flush=True)
     time.sleep(120)

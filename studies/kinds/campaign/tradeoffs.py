@@ -12,45 +12,45 @@ optimum of zero stiffness.
 
 from __future__ import annotations
 
-from typing import Literal
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from pydantic import Field, model_validator
 
-from railopt.design import MinimaxProblem, epsilon_sweep, nondominated, objective_surface
-from railopt.studies.base import FiniteModel
+from railopt.design import MinimaxProblem, Surface, epsilon_sweep, nondominated, objective_surface
+from railopt.studies.adapter import ResponseTarget, minimax_problem
 from railopt.studies.catalog import ModelSetup
-from railopt.studies.problem import ResponseTarget, minimax_problem
+from railopt.studies.kinds.campaign.config import SurfaceSpec, TradeoffSpec
+
+__all__ = ["Tradeoff", "TradeoffSurfaces", "constrained_problem", "surfaces", "sweep_designs", "tradeoff_table"]
 
 
-class TradeoffSpec(FiniteModel):
-    """One ε-constraint sweep: a constraint output (g = its f_k ≤ ε) or a check (value ≥ ε)."""
+@dataclass(frozen=True)
+class Tradeoff:
+    """One ε-constraint sweep: every distinct design with U and the traded quantity, the non-dominated front,
+    and — when the best optimum fails its first check — that check's result and the best design meeting it."""
 
-    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
-    output: str | None = None
-    check: str | None = None
-    epsilons: list[float] = Field(min_length=2)
-    method: Literal["slsqp", "cobyla", "slp"] = "slsqp"
-    n_starts: int = Field(4, ge=1, le=1000, strict=True)
-    exact: bool = True
+    spec: TradeoffSpec
+    table: pd.DataFrame
+    front: pd.DataFrame
+    quantity: str
+    after_check: dict | None = None
+    pick: pd.Series | None = None
 
-    @model_validator(mode="after")
-    def _one(self) -> TradeoffSpec:
-        if (self.output is None) == (self.check is None):
-            raise ValueError(f"tradeoffs.{self.name}: give exactly one of output or check")
-        if self.check is not None and self.method != "cobyla":
-            raise ValueError(f"tradeoffs.{self.name}.method: a check is not differentiable; use method = 'cobyla'")
-        return self
+    @property
+    def flagged(self) -> bool:
+        """The best optimum fails the check this sweep trades against."""
+        return (self.spec.check is not None and self.after_check is not None
+                and not self.after_check.get("stable", True))
 
 
-class SurfaceSpec(FiniteModel):
-    """U over two design variables (the others at the optimum); ``relax`` scales the lower bounds of the
-    unconstrained grid toward zero."""
+@dataclass(frozen=True)
+class TradeoffSurfaces:
+    """U over two design variables: constrained (inside the bounds) and relaxed toward zero."""
 
-    variables: tuple[str, str]
-    points: int = Field(21, ge=3, le=201, strict=True)
-    relax: float = Field(0.01, gt=0, lt=1)
+    spec: SurfaceSpec
+    constrained: Surface
+    unconstrained: Surface
 
 
 def constrained_problem(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget,
@@ -65,14 +65,14 @@ def constrained_problem(problem: MinimaxProblem, setup: ModelSetup, objective: R
 
     def negative_check(x: np.ndarray) -> np.ndarray:
         p, _ = setup.parameters(names, x)
-        value, _ = check(p)
+        value = check(p).value
         return np.array([-value if np.isfinite(value) else -1e12])  # stable over the range: no constraint
 
     return problem.with_constraints(negative_check)
 
 
-def tradeoff_table(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget, spec: TradeoffSpec,
-                   band: tuple[float, float], starts: pd.DataFrame, seed: int, client=None) -> pd.DataFrame:
+def sweep_designs(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget, spec: TradeoffSpec,
+                  band: tuple[float, float], starts: pd.DataFrame, seed: int, client=None) -> pd.DataFrame:
     """Sweep optima and campaign starts with U and the traded quantity; ``nondominated`` marks the front."""
     names = list(problem.space.names)
     cp = constrained_problem(problem, setup, objective, spec, band)
@@ -95,8 +95,23 @@ def tradeoff_table(problem: MinimaxProblem, setup: ModelSetup, objective: Respon
     return designs
 
 
-def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, optimum: np.ndarray, client=None):
-    """(constrained, unconstrained) :class:`~railopt.design.Surface` of U over ``spec.variables``."""
+def tradeoff_table(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget, spec: TradeoffSpec,
+                   band: tuple[float, float], starts: pd.DataFrame, seed: int, client=None,
+                   after_check: dict | None = None) -> Tradeoff:
+    """The sweep of ``spec`` (:func:`sweep_designs`), its front, and the best front design meeting the check."""
+    table = sweep_designs(problem, setup, objective, spec, band, starts, seed, client)
+    quantity = spec.output or spec.check
+    front = table[table["nondominated"]].sort_values("U")
+    result = Tradeoff(spec, table, front, quantity, after_check)
+    if result.flagged:
+        ok = front[front[quantity] > after_check.get("required_speed_m_s", np.nan)]
+        if len(ok):
+            result = Tradeoff(spec, table, front, quantity, after_check, ok.sort_values("U").iloc[0])
+    return result
+
+
+def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, optimum: np.ndarray, client=None) -> TradeoffSurfaces:
+    """The constrained and unconstrained :class:`~railopt.design.Surface` of U over ``spec.variables``."""
     space = problem.space
     grids = []
     for relaxed in (False, True):
@@ -108,4 +123,4 @@ def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, optimum: np.ndarray, cl
                 lo = lo * spec.relax
             axes.append(np.geomspace(lo, hi, spec.points) if lo > 0 else np.linspace(lo, hi, spec.points))
         grids.append(objective_surface(problem, spec.variables, axes[0], axes[1], optimum, client=client))
-    return grids[0], grids[1]
+    return TradeoffSurfaces(spec, grids[0], grids[1])

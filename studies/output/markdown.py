@@ -1,11 +1,12 @@
-"""Small writers shared by the studies: markdown tables and files in the staging folder."""
+"""Markdown for study summaries: tables of DataFrames."""
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import pandas as pd
+
+__all__ = ["markdown_table"]
 
 
 def _cell(v: object, digits: int) -> str:
@@ -24,14 +25,3 @@ def markdown_table(df: pd.DataFrame, digits: int = 7) -> str:
     rule = "|" + "|".join("---" for _ in df.columns) + "|"
     rows = ["| " + " | ".join(_cell(v, digits) for v in row) + " |" for row in df.itertuples(index=False)]
     return "\n".join([header, rule, *rows])
-
-
-def write_table(df: pd.DataFrame, outdir: Path, stem: str, parquet: bool = False) -> list[str]:
-    """Write ``stem.csv`` (and ``stem.parquet``) into ``outdir``; returns the file names."""
-    outdir.mkdir(parents=True, exist_ok=True)
-    df.to_csv(outdir / f"{stem}.csv", index=False)
-    names = [f"{stem}.csv"]
-    if parquet:
-        df.to_parquet(outdir / f"{stem}.parquet", index=False)
-        names.append(f"{stem}.parquet")
-    return names

@@ -18,6 +18,8 @@ from railopt.models import LinearSystem
 from railopt.models.sensitivity import maxima_jacobians
 from railopt.studies.catalog import ModelSetup
 
+__all__ = ["ResponseTarget", "minimax_problem"]
+
 
 @dataclass(frozen=True)
 class ResponseTarget:
@@ -41,7 +43,7 @@ class _Evaluator:
         key = np.asarray(x, dtype=float).tobytes()
         if key != self._key:
             p, dp = self.setup.parameters(self.names, np.asarray(x, dtype=float))
-            self._sys, self._dp, self._key = self.setup.system.at(p), dp, key
+            self._sys, self._dp, self._key = self.setup.family.at(p), dp, key
         return self._sys, self._dp
 
     def maxima(self, x: np.ndarray, targets: Sequence[ResponseTarget]) -> tuple[np.ndarray, np.ndarray]:
@@ -72,7 +74,7 @@ def minimax_problem(
     evaluator = _Evaluator(setup, names)
     if not constraints:
         return MinimaxProblem(list(variables), lambda x: evaluator.maxima(x, [objective]), jacobian=True)
-    epsilon = np.repeat(np.asarray(limits, dtype=float), setup.system.n + 2)  # n + 2 maxima per constraint
+    epsilon = np.repeat(np.asarray(limits, dtype=float), setup.family.n + 2)  # n + 2 maxima per constraint
     return MinimaxProblem(
         list(variables),
         lambda x: evaluator.maxima(x, [objective]),

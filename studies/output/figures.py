@@ -16,6 +16,20 @@ from matplotlib.figure import Figure
 
 from railopt.models.units import INCH
 
+__all__ = [
+    "Curve",
+    "plot_amplification",
+    "plot_before_after",
+    "plot_forced_response",
+    "plot_frf_panels",
+    "plot_profiles",
+    "plot_root_loci_before_after",
+    "plot_root_locus",
+    "plot_surfaces",
+    "plot_time_histories",
+    "plot_tradeoff",
+]
+
 _UNITS = ("inch-pound", "SI")
 
 

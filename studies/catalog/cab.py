@@ -1,0 +1,53 @@
+"""The cab ride model of the flagship study (thesis §4.3.3), registered in the model catalog.
+
+``cab_lateral``: the body's lateral/roll/yaw motion on the secondary suspension with the trucks
+following a lateral irregularity (:mod:`railopt.models.vehicle.cab`); every suspension element acting
+on the body is designable by id or alias.  Its ``hunting`` check puts a design into the full lateral
+model with creep (rigid and flexible track) and reports the critical speeds and the least damping
+ratio up to the maximum operating speed — the stability check of every distinct optimum.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field
+
+from railopt.models.units import INCH, MPH
+from railopt.models.vehicle.cab import CabInput, cab_lateral_model
+from railopt.studies.catalog import ModelSetup, register_model
+from railopt.studies.catalog.vehicle import load, vehicle_setup
+from railopt.studies.config import StrictModel
+
+__all__ = ["CabOptions", "cab_lateral_setup"]
+
+
+class CabOptions(StrictModel):
+    vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
+    amplitude_in: float = Field(0.25, gt=0, lt=100, allow_inf_nan=False, description="lateral irregularity, in")
+    max_frequency_hz: float = Field(3.0, gt=0, lt=1000, allow_inf_nan=False)
+    max_speed_mph: float = Field(150.0, gt=0, lt=1000, allow_inf_nan=False, description="speed at max_frequency_hz")
+    mode: Literal["fixed_wavelength", "fixed_speed"] = "fixed_wavelength"
+    max_operating_speed_mph: float = Field(70.0, gt=0, lt=1000, allow_inf_nan=False,
+                                           description="the hunting check requires stability up to this speed")
+    critical_search_mph: tuple[float, float] = Field((2.0, 300.0), description="critical-speed search range")
+    parameters: dict[str, float] = Field(default_factory=dict, description="values overriding the vehicle file")
+
+
+@register_model("cab_lateral", CabOptions,
+                "thesis §4.3.3 cab model: body lateral/roll/yaw on the secondary suspension, trucks following a "
+                "lateral irregularity; outputs cab_acceleration (m/s²), cab_displacement, strokes")
+def cab_lateral_setup(options: CabOptions) -> ModelSetup:
+    vehicle = load(options)
+    cab = cab_lateral_model(vehicle, CabInput(options.amplitude_in * INCH, options.max_frequency_hz,
+                                              options.max_speed_mph * MPH, options.mode))
+    family = cab.system.with_values(cab.parameters())
+    aliases = {a: k for a, k in vehicle.element_aliases().items() if k in family.parameters}
+    if options.mode == "fixed_wavelength":
+        description = (f"{vehicle.name} cab model, ±{options.amplitude_in:g} in lateral irregularity, "
+                       f"λ = {cab.cab_input.wavelength_m:.2f} m")
+    else:
+        description = f"{vehicle.name} cab model, S = {options.max_speed_mph:g} mph"
+    search = (options.critical_search_mph[0] * MPH, options.critical_search_mph[1] * MPH)
+    return vehicle_setup(vehicle, family, description, ("rigid", "flexible"), search,
+                         options.max_operating_speed_mph * MPH, abscissa=family, aliases=aliases)

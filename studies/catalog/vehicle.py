@@ -1,0 +1,166 @@
+"""Catalog models of a vehicle file: ``vehicle_lateral`` (unforced, with creep) and ``vehicle_forced``.
+
+Both are built by :func:`vehicle_setup`, the one path from a vehicle and a family to a
+:class:`~railopt.studies.catalog.ModelSetup`: every suspension element designable by id (or alias), the
+file's values as the existing design, the unforced lateral family on each track for stability, and the
+checks ``spectral_abscissa`` (at the model's speed) and ``hunting`` (:class:`HuntingCheck`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Literal
+
+from pydantic import Field
+
+from railopt.models import ParametricSystem
+from railopt.models.vehicle import load_vehicle
+from railopt.studies.catalog import AbscissaCheck, HuntingCheck, ModelSetup, ParameterMap, register_model
+from railopt.studies.config import Interval, StrictModel
+
+__all__ = [
+    "IrregularityOptions",
+    "VehicleForcedOptions",
+    "VehicleOptions",
+    "lateral_family",
+    "load",
+    "vehicle_forced_model",
+    "vehicle_setup",
+]
+
+
+def load(options):
+    """The vehicle of ``options`` (a bundled name or a file) with its ``parameters`` overrides."""
+    vehicle = load_vehicle(options.vehicle)
+    return vehicle.with_parameters(options.parameters) if options.parameters else vehicle
+
+
+def lateral_family(vehicle, track: str, names: Sequence[str]) -> ParametricSystem:
+    """The vehicle's unforced lateral family on ``track`` in those of ``names`` that act laterally."""
+    view = vehicle.lateral(track=track)
+    return view.family([n for n in names if n in view.parts or n in view.aliases])
+
+
+def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: Sequence[str],
+                  search: tuple[float, float], max_speed: float, abscissa: ParametricSystem | None = None,
+                  aliases: dict[str, str] | None = None) -> ModelSetup:
+    """A vehicle model ready for a study.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        The vehicle (parameters already overridden).
+    family : ParametricSystem
+        The study's family; its parameters (element ids) and values are the designable parameters and
+        the existing design.
+    description : str
+        One line for reports.
+    tracks : sequence of {"rigid", "flexible"}
+        Tracks of the stability families (root loci: the first; hunting check: all).
+    search : (float, float)
+        Critical-speed search range, m/s.
+    max_speed : float
+        The hunting check requires stability up to this speed, m/s.
+    abscissa : ParametricSystem, optional
+        The unforced family whose spectral abscissa (at its speed) is the ``spectral_abscissa`` check;
+        default: the first stability family at ``family``'s speed.
+    aliases : mapping alias -> id, optional
+        Readable names, designable and set in the existing design too.
+    """
+    names = tuple(family.parameters)
+    aliases = dict(aliases or {})
+    stability = {track: lateral_family(vehicle, track, names) for track in tracks}
+    if abscissa is None:
+        abscissa = stability[tracks[0]].with_values(stability[tracks[0]].values, speed=family.speed)
+    existing = dict(zip(names, family.values, strict=True))
+    existing |= {a: float(existing[k]) for a, k in aliases.items()}
+    return ModelSetup(
+        family=family,
+        parameter_map=ParameterMap(names, family.values, aliases),
+        named_designs={"existing": existing},
+        checks={"spectral_abscissa": AbscissaCheck(abscissa),
+                "hunting": HuntingCheck(stability, names, search, max_speed)},
+        stability=stability,
+        description=description,
+    )
+
+
+class HuntingOptions(StrictModel):
+    """Options of the ``hunting`` check of a vehicle model."""
+
+    max_operating_speed_m_s: float | None = Field(
+        None, gt=0, lt=1000, allow_inf_nan=False,
+        description="the hunting check requires stability up to this speed (default: speed_m_s)")
+    critical_search_m_s: Interval = Field((1.0, 150.0), description="critical-speed search range of the hunting check")
+
+    def hunting(self, speed: float) -> tuple[tuple[float, float], float]:
+        """(search range, maximum operating speed), m/s."""
+        return self.critical_search_m_s, self.max_operating_speed_m_s or speed
+
+
+class VehicleOptions(HuntingOptions):
+    vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
+    track: Literal["rigid", "flexible"] = "rigid"
+    speed_m_s: float = Field(30.0, gt=0, lt=1000, allow_inf_nan=False, description="forward speed of `system`")
+    output: str | None = Field(None, description="output row of the model (e.g. cab.lateral)")
+    parameters: dict[str, float] = Field(default_factory=dict, description="values overriding the vehicle file")
+
+
+@register_model("vehicle_lateral", VehicleOptions,
+                "lateral model (v, α, γ) of a vehicle file with creep; speed-dependent (stability)")
+def vehicle_lateral_setup(options: VehicleOptions) -> ModelSetup:
+    """The lateral model of a vehicle file; every suspension element is designable by id or alias."""
+    vehicle = load(options)
+    model = vehicle.lateral(track=options.track, speed=options.speed_m_s)
+    family = model.family(list(model.parts), outputs=[options.output or model.coordinates[0]])
+    return vehicle_setup(vehicle, family, f"{vehicle.name}, lateral, {options.track} track", [options.track],
+                         *options.hunting(options.speed_m_s))
+
+
+# ---------------------------------------------------------------------------------------------- forced response
+class IrregularityOptions(StrictModel):
+    """A sinusoidal rail irregularity (:class:`railopt.models.vehicle.irregularity.Irregularity`)."""
+
+    kind: Literal["vertical", "alignment", "cross_level", "lateral"] = "vertical"
+    amplitude_m: float = Field(0.00635, gt=0, lt=1.0, allow_inf_nan=False, description="per rail, m")
+    rails: Literal["in_phase", "out_of_phase"] | None = None
+
+
+class VehicleForcedOptions(HuntingOptions):
+    vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
+    track: Literal["rigid", "flexible"] = "rigid"
+    speed_m_s: float = Field(30.0, gt=0, lt=1000, allow_inf_nan=False, description="forward speed S, m/s")
+    view: Literal["vertical", "lateral"] = "vertical"
+    input: IrregularityOptions = Field(default_factory=IrregularityOptions)
+    outputs: list[str] = Field(default_factory=lambda: ["body.w"], min_length=1,
+                               description="coordinates, named rows or body points '<body>[x,y,z].<x|y|z>'")
+    quantity: Literal["displacement", "velocity", "acceleration"] = "displacement"
+    parameters: dict[str, float] = Field(default_factory=dict, description="values overriding the vehicle file")
+
+
+def vehicle_forced_model(options: VehicleForcedOptions):
+    """``(vehicle, VehicleView, Irregularity)`` of the options (errors name the option)."""
+    from railopt.models.vehicle.irregularity import Irregularity
+
+    vehicle = load(options)
+    view = vehicle.vertical if options.view == "vertical" else vehicle.lateral
+    model = view(track=options.track, speed=options.speed_m_s)
+    try:
+        irregularity = Irregularity(options.input.kind, options.input.amplitude_m, options.input.rails)
+    except ValueError as exc:
+        raise ValueError(str(exc)) from None
+    return vehicle, model, irregularity
+
+
+@register_model("vehicle_forced", VehicleForcedOptions,
+                "a vehicle's vertical or lateral model forced by a delayed sinusoidal rail irregularity "
+                "(4.60)-(4.70); outputs as listed, every suspension element designable")
+def vehicle_forced_setup(options: VehicleForcedOptions) -> ModelSetup:
+    """The forced response as a ParametricSystem in every suspension element (ids), delays declared."""
+    vehicle, model, irregularity = vehicle_forced_model(options)
+    names = list(model.parts)
+    family = model.family(names, input=irregularity, outputs=options.outputs, quantity=options.quantity)
+    description = (f"{model.name}, {options.view}, {options.track} track, S = {options.speed_m_s:g} m/s, "
+                   f"{irregularity.label}")
+    return vehicle_setup(vehicle, family, description, [options.track], *options.hunting(options.speed_m_s),
+                         abscissa=model.family(names))

@@ -1,0 +1,222 @@
+"""The config of the ``campaign`` kind: models, design variables, objective, constraints, methods × objectives,
+starts, checks, report, trade-offs and surfaces.  Everything a run would reject is rejected on validation
+(``railopt validate`` = ``run``); method names are those of the design registry."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+from pydantic import Field, field_validator, model_validator
+
+from railopt.design import DesignVariable
+from railopt.models.units import RAD_PER_HZ
+from railopt.studies.adapter import ResponseTarget
+from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
+from railopt.studies.config import BandHz, FiniteModel, MethodName, StrictModel
+
+__all__ = [
+    "CampaignDesign",
+    "CampaignSettings",
+    "CampaignStudyConfig",
+    "ConstraintSpec",
+    "OutputSpec",
+    "ReportSpec",
+    "SolverOptions",
+    "SurfaceSpec",
+    "TradeoffSpec",
+    "VariableSpec",
+]
+
+
+class SolverOptions(StrictModel):
+    xtol: float = Field(1e-10, gt=0, strict=True)  # strict: `true` is not a number
+    ftol: float = Field(1e-12, gt=0, strict=True)
+    maxeval: int = Field(3000, gt=0, strict=True)
+    maxtime: float = Field(120.0, gt=0, strict=True)
+
+
+class CampaignSettings(StrictModel):
+    """The ``[design]`` table shared by campaign studies."""
+
+    method: MethodName = "slsqp"
+    n_starts: int = Field(16, gt=0, strict=True)  # strict: `true` or 16.0 is not a count
+    sampler: Literal["sobol", "lhs"] = "sobol"
+    seed: int = Field(0, ge=0, strict=True)
+    options: SolverOptions = SolverOptions()
+
+    def solver_options(self) -> dict[str, Any]:
+        return self.options.model_dump()
+
+
+class VariableSpec(FiniteModel):
+    name: str
+    lower: float
+    upper: float
+    scale: Literal["linear", "log"] = "linear"
+
+    @model_validator(mode="after")
+    def _bounds(self) -> VariableSpec:
+        DesignVariable(self.name, self.lower, self.upper, self.scale)  # same rules as the design layer
+        return self
+
+    def variable(self) -> DesignVariable:
+        return DesignVariable(self.name, self.lower, self.upper, self.scale)
+
+
+class OutputSpec(FiniteModel):
+    """An output of the model over a band (Hz)."""
+
+    output: str | None = None
+    band_hz: BandHz
+
+    def target(self, setup: ModelSetup, exact: bool) -> ResponseTarget:
+        output = self.output or setup.family.output_names[0]
+        return ResponseTarget(output, (self.band_hz[0] * RAD_PER_HZ, self.band_hz[1] * RAD_PER_HZ), exact)
+
+
+class ConstraintSpec(OutputSpec):
+    """f_k of ``output`` ≤ ``limit`` (units of the output) — the ε of ε-constraint sweeps."""
+
+    limit: float = Field(gt=0)
+    exact: bool = True
+
+
+class CampaignDesign(CampaignSettings):
+    """``[design]``: variables, the methods × objectives matrix, starts, solver options."""
+
+    variables: list[VariableSpec] = Field(min_length=1)
+    methods: list[MethodName] = Field(default=["slsqp"], min_length=1)
+    objectives: list[Literal["thesis", "exact"]] = Field(default=["exact"], min_length=1)
+    start_from: list[str] = Field(default_factory=list, description="named designs of each model used as starts")
+    points: list[dict[str, float]] = Field(default_factory=list, description="explicit starts {variable: value}")
+    checks: list[str] = Field(default_factory=lambda: ["spectral_abscissa"], description="checks of each optimum")
+    method: MethodName = "slsqp"  # set per campaign from `methods`, never by the config
+
+    @field_validator("method")  # runs only for a value written in the config (defaults are not validated)
+    @classmethod
+    def _no_single_method(cls, v: str) -> str:
+        raise ValueError(f"this kind runs every entry of `methods`; write methods = [{v!r}] instead")
+
+    @field_validator("methods", "objectives")
+    @classmethod
+    def _unique(cls, v: list[str]) -> list[str]:
+        if len(set(v)) != len(v):
+            raise ValueError(f"entries must be unique, got {v}")
+        return v
+
+
+class ReportSpec(StrictModel):
+    compare: list[str] = Field(default_factory=list, description="named designs reported beside the optima")
+    before: str | None = Field(None, description="a named design reported before/after against the best optimum")
+    outputs: list[str] = Field(default_factory=list, description="outputs shown before/after (default: objective)")
+    inch_outputs: list[str] = Field(default_factory=list, description="outputs also reported in inches (m → in)")
+    locus_speeds_m_s: tuple[float, float] | None = Field(None, description="root locus before/after over speed")
+    published: dict[str, tuple[float, float]] = Field(
+        default_factory=dict, description="output -> published (before, after) peaks, in inches for inch_outputs")
+    frf_points: int = Field(800, ge=50, le=20000)
+    dpi: int = Field(110, ge=50, le=300)
+
+
+class TradeoffSpec(FiniteModel):
+    """One ε-constraint sweep: a constraint output (g = its f_k ≤ ε) or a check (value ≥ ε)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
+    output: str | None = None
+    check: str | None = None
+    epsilons: list[float] = Field(min_length=2)
+    method: MethodName = "slsqp"
+    n_starts: int = Field(4, ge=1, le=1000, strict=True)
+    exact: bool = True
+
+    @model_validator(mode="after")
+    def _one(self) -> TradeoffSpec:
+        if (self.output is None) == (self.check is None):
+            raise ValueError(f"tradeoffs.{self.name}: give exactly one of output or check")
+        if self.check is not None and self.method != "cobyla":
+            raise ValueError(f"tradeoffs.{self.name}.method: a check is not differentiable; use method = 'cobyla'")
+        return self
+
+
+class SurfaceSpec(FiniteModel):
+    """U over two design variables (the others at the optimum); ``relax`` scales the lower bounds of the
+    unconstrained grid toward zero."""
+
+    variables: tuple[str, str]
+    points: int = Field(21, ge=3, le=201, strict=True)
+    relax: float = Field(0.01, gt=0, lt=1)
+
+
+class CampaignStudyConfig(ModelsStudy):
+    KIND: ClassVar[str] = "campaign"
+    objective: OutputSpec
+    constraints: list[ConstraintSpec] = Field(default_factory=list)
+    design: CampaignDesign
+    report: ReportSpec = ReportSpec()
+    tradeoffs: list[TradeoffSpec] = Field(default_factory=list)
+    surfaces: list[SurfaceSpec] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _resolve(self) -> CampaignStudyConfig:
+        """Everything a run would reject is rejected here (``railopt validate`` = ``run``)."""
+        require_unique("design.variables", [v.name for v in self.design.variables])
+        for i, ref in enumerate(self.models):
+            where = f"models[{i}]"
+            setup = ref.setup(where)
+            _check_setup(self, setup, where)
+        return self
+
+    def setups(self) -> dict[str, ModelSetup]:
+        return {m.label: m.setup(f"models[{i}]") for i, m in enumerate(self.models)}
+
+
+def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:
+    names = [v.name for v in cfg.design.variables]
+    bad = [n for n in names if n not in setup.designable]
+    if bad:
+        raise ValueError(f"design.variables: {bad} are not parameters of {where}; choose from {list(setup.designable)}")
+    outputs = setup.family.output_names
+    specs = [("objective", cfg.objective)] + [(f"constraints[{i}]", c) for i, c in enumerate(cfg.constraints)]
+    for field, spec in specs:
+        if spec.output is not None and spec.output not in outputs:
+            raise ValueError(f"{field}.output: unknown output {spec.output!r} of {where}; outputs are {list(outputs)}")
+    before = [cfg.report.before] if cfg.report.before else []
+    for field, named in (("design.start_from", cfg.design.start_from), ("report.compare", cfg.report.compare),
+                         ("report.before", before)):
+        for name in named:
+            if name not in setup.named_designs:
+                raise ValueError(f"{field}: {where} has no named design {name!r}; it has {sorted(setup.named_designs)}")
+            missing = [n for n in names if n not in setup.named_designs[name]]
+            if missing:
+                raise ValueError(f"{field}: named design {name!r} of {where} does not set {missing}")
+    for i, point in enumerate(cfg.design.points):
+        if sorted(point) != sorted(names):
+            raise ValueError(f"design.points[{i}]: must give exactly the variables {names}, got {sorted(point)}")
+        for v in cfg.design.variables:
+            if not (v.lower <= point[v.name] <= v.upper) or not np.isfinite(point[v.name]):
+                raise ValueError(f"design.points[{i}].{v.name}: {point[v.name]} outside [{v.lower}, {v.upper}]")
+    for field, wanted in (("report.outputs", cfg.report.outputs), ("report.inch_outputs", cfg.report.inch_outputs),
+                          ("report.published", list(cfg.report.published)),
+                          ("tradeoffs.output", [t.output for t in cfg.tradeoffs if t.output])):
+        bad = [o for o in wanted if o not in outputs]
+        if bad:
+            raise ValueError(f"{field}: {bad} are not outputs of {where}; outputs are {list(outputs)}")
+    for t in cfg.tradeoffs:
+        if t.check is not None and t.check not in setup.checks:
+            raise ValueError(f"tradeoffs.{t.name}.check: {where} has no check {t.check!r}")
+    for sp in cfg.surfaces:
+        bad = [v for v in sp.variables if v not in names]
+        if bad or sp.variables[0] == sp.variables[1]:
+            raise ValueError(f"surfaces.variables: need two different design variables of {names}, got {sp.variables}")
+    if cfg.report.locus_speeds_m_s is not None and not setup.stability:
+        raise ValueError(f"report.locus_speeds_m_s: {where} has no forward speed")
+    for name in cfg.design.checks:
+        if name not in setup.checks:
+            raise ValueError(f"design.checks: {where} has no check {name!r}; it has {sorted(setup.checks)}")
+    # the model must evaluate at every start before anything is written
+    for name in cfg.design.start_from:
+        point = [setup.named_designs[name][n] for n in names]
+        for v, x in zip(cfg.design.variables, point, strict=True):
+            if not (v.lower <= x <= v.upper):
+                raise ValueError(f"design.start_from: named design {name!r}: {v.name} = {x:g} is outside its bounds")
+        setup.parameters(names, np.array(point))

@@ -1,0 +1,379 @@
+"""Compute of the ``campaign`` kind: the campaigns (models × objectives × methods) into their resumable stores,
+the checks of every distinct optimum, the comparison with named designs, and the data of the report's
+sections (FRFs at the optima, before/after, stability, root loci, trade-offs, surfaces).  Writes no file
+but the campaign stores."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from railopt.design import CampaignStore, MinimaxProblem, check_designs, distinct_optima, multistart
+from railopt.models.stability import root_locus
+from railopt.models.units import RAD_PER_HZ as HZ
+from railopt.models.units import m_to_in
+from railopt.studies.adapter import minimax_problem
+from railopt.studies.catalog import Check, ModelSetup
+from railopt.studies.kind import StudyContext, dask_context
+from railopt.studies.kinds.campaign.config import CampaignSettings, CampaignStudyConfig
+from railopt.studies.kinds.campaign.tradeoffs import Tradeoff, TradeoffSurfaces, surfaces, tradeoff_table
+
+__all__ = [
+    "BeforeAfter",
+    "CampaignResult",
+    "ModelSections",
+    "campaign_label",
+    "campaign_problem",
+    "check_optima",
+    "check_stores",
+    "compute",
+    "design_peak",
+    "run_campaign",
+    "store_path",
+]
+
+
+# ---------------------------------------------------------------------------------------------- stores and runs
+def store_path(context: StudyContext, label: str) -> Path:
+    return context.store_dir / "campaigns" / f"{label}.sqlite"
+
+
+def check_stores(context: StudyContext, labels: list[str]) -> None:
+    """Before any work: an existing store without --resume is an error naming the file."""
+    if context.resume:
+        return
+    existing = [str(store_path(context, lb)) for lb in labels if store_path(context, lb).exists()]
+    if existing:
+        raise FileExistsError(
+            f"store: {', '.join(existing)} already exist(s); pass --resume to finish or reuse them, "
+            "or --fresh to discard them"
+        )
+
+
+def run_campaign(
+    problem: MinimaxProblem,
+    label: str,
+    settings: CampaignSettings,
+    context: StudyContext,
+    config: dict[str, Any],
+    client: Any = None,
+    points: list[list[float]] | None = None,
+) -> pd.DataFrame:
+    """Run (or resume) one campaign into ``<store_dir>/campaigns/<label>.sqlite``; returns its table."""
+    path = store_path(context, label)
+    if path.exists():
+        store = CampaignStore.open(path, expect_config=config)
+    else:
+        store = CampaignStore.create(path, label, config, list(problem.space.names))
+    bar = tqdm(desc=label, unit="start", file=sys.stderr, disable=not context.show_progress, mininterval=0.5)
+
+    def progress(done: int, total: int) -> None:
+        bar.total = total
+        bar.n = done
+        bar.refresh()
+
+    try:
+        return multistart(problem, settings.n_starts, method=settings.method, seed=settings.seed,
+                          sampler=settings.sampler, points=points, client=client, store=store,
+                          options=settings.solver_options(), progress=progress)
+    finally:
+        bar.close()
+        store.close()
+
+
+def _design_check(setup: ModelSetup, names: list[str], check: Check):
+    """A check of the design x through the setup's parameter map, as the design layer runs it (a task):
+    ``x -> (value, payload)``."""
+
+    def on_design(x: np.ndarray) -> tuple[float, dict]:
+        p, _ = setup.parameters(names, x)
+        result = check(p)
+        return result.value, result.payload()
+
+    return on_design
+
+
+def check_optima(optima: pd.DataFrame, setup: ModelSetup, names: list[str], label: str, context: StudyContext,
+                 name: str, client: Any = None) -> tuple[pd.DataFrame, list[str]]:
+    """Run check ``name`` of ``setup`` on each distinct optimum as tasks (results go to the campaign's store).
+
+    Returns ``optima`` with a column ``name`` (the check's value) and the check's payload (a column already in
+    ``optima`` is prefixed ``name.``), and the columns of the check's flags."""
+    check = setup.checks[name]
+    with CampaignStore.open(store_path(context, label)) as store:
+        checks = check_designs(_design_check(setup, names, check), optima, names, name, client=client, store=store)
+    checks = checks.drop(columns="name").rename(columns={"value": name})
+    renamed = {c: f"{name}.{c}" for c in checks.columns if c not in ("start_id", name) and c in optima.columns}
+    checks = checks.rename(columns=renamed)
+    return optima.merge(checks, on="start_id", how="left"), [renamed.get(f, f) for f in check.flag_names]
+
+
+# ---------------------------------------------------------------------------------------------- problems
+def campaign_label(model: str, objective: str, method: str) -> str:
+    return f"{model}-{objective}-{method}"
+
+
+def campaign_problem(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str) -> MinimaxProblem:
+    """The minimax problem of one model and objective kind ("thesis" or "exact")."""
+    exact = objective == "exact"
+    constraints = [c.target(setup, c.exact) for c in cfg.constraints]
+    return minimax_problem(setup, [v.variable() for v in cfg.design.variables], cfg.objective.target(setup, exact),
+                           constraints, [c.limit for c in cfg.constraints])
+
+
+def _p(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, float]) -> np.ndarray:
+    names = [v.name for v in cfg.design.variables]
+    return setup.parameters(names, np.array([values[n] for n in names]))[0]
+
+
+def design_peak(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, float]) -> float:
+    """Certified band maximum of the objective output at a design {variable: value}."""
+    target = cfg.objective.target(setup, exact=True)
+    return setup.family.at(_p(cfg, setup, values)).peak(target.band, exact=True, output=target.output)
+
+
+def _starts(cfg: CampaignStudyConfig, setup: ModelSetup) -> list[list[float]] | None:
+    names = [v.name for v in cfg.design.variables]
+    points = [[setup.named_designs[nm][n] for n in names] for nm in cfg.design.start_from]
+    points += [[p[n] for n in names] for p in cfg.design.points]
+    return points or None
+
+
+# ---------------------------------------------------------------------------------------------- comparison
+def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str], table: pd.DataFrame,
+                    optima: pd.DataFrame, flags: list[str]) -> dict:
+    names = [v.name for v in cfg.design.variables]
+    model, objective, method = key
+    ok = table[table["success"]]
+    row: dict = {"model": model, "objective": objective, "method": method, "starts": len(table),
+                 "converged": int(table["success"].sum()), "success_rate": float(table["success"].mean()),
+                 "distinct_optima": len(optima), "evaluations": int(table["evaluations"].sum()),
+                 "wall_time_s": float(table["wall_time"].sum())}
+    row["all_optima_pass_checks"] = bool(optima[flags].all().all()) if flags else None
+    if len(ok):
+        best = ok.sort_values(["value", "start_id"]).iloc[0]
+        values = {n: float(best[n]) for n in names}
+        peak = design_peak(cfg, setup, values)
+        row |= {**values, "U_objective": float(best["value"]), "true_peak": peak,
+                "objective_underestimate": (peak - float(best["value"])) / peak,
+                "best_start": int(best["start_id"])}
+        for ref in cfg.report.compare:
+            ref_values = setup.named_designs[ref]
+            ref_peak = design_peak(cfg, setup, ref_values)
+            row[f"{ref}_peak"] = ref_peak
+            row[f"rel_err_vs_{ref}"] = (peak - ref_peak) / ref_peak
+            for n in names:
+                row[f"{n}_err_vs_{ref}"] = values[n] - ref_values[n]
+    return row
+
+
+def _short(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
+    cols = ["model", "objective", "method", *names, "U_objective", "true_peak", "converged", "starts",
+            "distinct_optima"]
+    cols += [c for c in comparison.columns if c.startswith("rel_err_vs_")]
+    return comparison[[c for c in cols if c in comparison.columns]]
+
+
+def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], comparison: pd.DataFrame) -> list:
+    """|H| of the objective output over its band at each campaign's best design and the named designs."""
+    panels = []
+    f_hz = np.linspace(cfg.objective.band_hz[0], cfg.objective.band_hz[1], cfg.report.frf_points)
+    names = [v.name for v in cfg.design.variables]
+    for model, setup in setups.items():
+        target = cfg.objective.target(setup, exact=True)
+        curves = []
+        for ref in cfg.report.compare:
+            curves.append((f"{ref} (peak {design_peak(cfg, setup, setup.named_designs[ref]):.6g})", f_hz,
+                           np.abs(setup.family.at(_p(cfg, setup, setup.named_designs[ref])).frf(
+                               f_hz * HZ, target.output)), "ref"))
+        for _, r in comparison[comparison["model"] == model].iterrows():
+            if not np.isfinite(r.get("true_peak", np.nan)):
+                continue
+            p = _p(cfg, setup, {n: r[n] for n in names})
+            curves.append((f"railopt {r['objective']}/{r['method']} (peak {r['true_peak']:.6g})", f_hz,
+                           np.abs(setup.family.at(p).frf(f_hz * HZ, target.output)), r["objective"]))
+        panels.append((f"{model}: {setup.description}", f"|H| of {target.output}", curves))
+    return panels
+
+
+# ---------------------------------------------------------------------------------------------- report sections
+@dataclass(frozen=True)
+class BeforeAfter:
+    """A named design against the best optimum: maxima per output, FRFs, checks and root loci."""
+
+    table: pd.DataFrame
+    thesis: float  # thesis approximation at the optimum
+    exact: float  # certified maximum at the optimum
+    active: list[str]  # active bounds at the optimum
+    frfs: list[tuple[str, np.ndarray, np.ndarray, np.ndarray, str]]  # output, f (Hz), |before|, |after|, unit
+    stability: pd.DataFrame | None
+    loci: dict[str, pd.DataFrame] | None
+
+
+@dataclass(frozen=True)
+class ModelSections:
+    """The report sections of one model: its best optimum, before/after, trade-offs and surfaces."""
+
+    model: str
+    tag: str
+    best: pd.Series | None
+    objective: str
+    before_after: BeforeAfter | None = None
+    tradeoffs: list[Tradeoff] = field(default_factory=list)
+    surfaces: list[TradeoffSurfaces] = field(default_factory=list)
+
+
+def _check_rows(cfg: CampaignStudyConfig, setup: ModelSetup, designs: dict[str, np.ndarray]) -> pd.DataFrame | None:
+    rows = [{"design": label, "check": name, "value": (r := setup.checks[name](p)).value, **r.payload()}
+            for label, p in designs.items() for name in cfg.design.checks]
+    return pd.DataFrame(rows) if rows else None
+
+
+def _active_bounds(cfg: CampaignStudyConfig, after: dict[str, float]) -> list[str]:
+    out = []
+    for v in cfg.design.variables:
+        width = v.upper - v.lower
+        if min(abs(after[v.name] - v.lower), abs(after[v.name] - v.upper)) <= 1e-6 * width:
+            side = "lower" if abs(after[v.name] - v.lower) <= 1e-6 * width else "upper"
+            out.append(f"{v.name} at its {side} bound")
+    return out
+
+
+def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, float],
+                  band: tuple[float, float]) -> BeforeAfter:
+    """Maxima, FRFs, checks and (with forward speed) root loci of the named design ``report.before`` and the
+    optimum ``after`` (Figs 4.13–4.17)."""
+    p_before = _p(cfg, setup, setup.named_designs[cfg.report.before])
+    p_after = _p(cfg, setup, after)
+    sys_b, sys_a = setup.family.at(p_before), setup.family.at(p_after)
+    outputs = cfg.report.outputs or [cfg.objective.target(setup, True).output]
+    rows = []
+    for o in outputs:
+        rb = sys_b.response_maxima(band, exact=True, output=o)
+        ra = sys_a.response_maxima(band, exact=True, output=o)
+        row = {"output": o, "before": rb.value, "after": ra.value, "reduction_factor": rb.value / ra.value,
+               "before_at_hz": rb.argmax_frequency / HZ, "after_at_hz": ra.argmax_frequency / HZ,
+               "certified": rb.certified and ra.certified}
+        if o in cfg.report.inch_outputs:
+            row |= {"before_in": m_to_in(rb.value), "after_in": m_to_in(ra.value)}  # in, in/s or in/s² by quantity
+        if o in cfg.report.published:
+            pb, pa = cfg.report.published[o]
+            row |= {"published_before": pb, "published_after": pa, "published_factor": pb / pa}
+        rows.append(row)
+    objective_output = cfg.objective.target(setup, True).output
+    f_hz = np.linspace(band[0] / HZ, band[1] / HZ, cfg.report.frf_points)
+    frfs = []
+    for o in outputs:
+        suffix = {"displacement": "", "velocity": "/s", "acceleration": "/s²"}[sys_a.outputs[o].quantity]
+        inch = o in cfg.report.inch_outputs
+        before, after_h = np.abs(sys_b.frf(f_hz * HZ, o)), np.abs(sys_a.frf(f_hz * HZ, o))
+        if inch:
+            before, after_h = m_to_in(before), m_to_in(after_h)
+        frfs.append((o, f_hz, before, after_h, f"in{suffix}" if inch else "SI units"))
+    loci = None
+    if cfg.report.locus_speeds_m_s is not None:
+        speeds = np.linspace(*cfg.report.locus_speeds_m_s, 80)
+        loci = {label: root_locus(setup.stability_model(p), speeds).to_pandas()
+                for label, p in (("before", p_before), ("after", p_after))}
+    return BeforeAfter(pd.DataFrame(rows), sys_a.response_maxima(band, exact=False, output=objective_output).value,
+                       sys_a.response_maxima(band, exact=True, output=objective_output).value,
+                       _active_bounds(cfg, after), frfs,
+                       _check_rows(cfg, setup, {"before": p_before, "after": p_after}), loci)
+
+
+def _after_check(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, float]) -> dict | None:
+    """The first design check at the best optimum (value and payload), or None without checks."""
+    if not cfg.design.checks:
+        return None
+    r = setup.checks[cfg.design.checks[0]](_p(cfg, setup, after))
+    return {"value": r.value, **r.payload()}
+
+
+def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, comparison: pd.DataFrame,
+                    tables: dict, tag: str, client) -> ModelSections:
+    """The before/after, trade-off and surface sections of one model, at its best optimum of the exact
+    objective (or of the first objective when exact is not run)."""
+    names = [v.name for v in cfg.design.variables]
+    objective = "exact" if "exact" in cfg.design.objectives else cfg.design.objectives[0]
+    rows = comparison[(comparison["model"] == model) & (comparison["objective"] == objective)]
+    rows = rows[np.isfinite(rows.get("true_peak", pd.Series(dtype=float)))]
+    if rows.empty:
+        return ModelSections(model, tag, None, objective)
+    best = rows.sort_values("true_peak").iloc[0]
+    after = {n: float(best[n]) for n in names}
+    problem = campaign_problem(cfg, setup, objective)
+    band = cfg.objective.target(setup, exact=True).band
+    before_after = _before_after(cfg, setup, after, band) if cfg.report.before else None
+    starts = pd.concat([t for (m, o, _), t in tables.items() if m == model and o == objective])
+    target = cfg.objective.target(setup, exact=objective == "exact")
+    hunting_after = _after_check(cfg, setup, after)
+    tradeoffs = [tradeoff_table(problem, setup, target, spec, band, starts, cfg.design.seed, client, hunting_after)
+                 for spec in cfg.tradeoffs]
+    x_after = np.array([after[n] for n in names])
+    grids = [surfaces(problem, spec, x_after, client) for spec in cfg.surfaces]
+    return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids)
+
+
+# ---------------------------------------------------------------------------------------------- compute
+@dataclass(frozen=True)
+class CampaignResult:
+    """Every campaign's starts and checked optima, the comparison, FRF panels and the report sections."""
+
+    config: CampaignStudyConfig
+    comparison: pd.DataFrame
+    starts: pd.DataFrame
+    optima: pd.DataFrame
+    table: pd.DataFrame  # the CLI's short comparison
+    frf_panels: list
+    sections: list[ModelSections]
+
+
+def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str], context: StudyContext,
+              client) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
+    """One campaign (model, objective, method): its starts, its checked distinct optima and their flags."""
+    model, objective, method = key
+    names = [v.name for v in cfg.design.variables]
+    problem = campaign_problem(cfg, setup, objective)
+    label = campaign_label(*key)
+    settings = cfg.design.model_copy(update={"method": method})
+    store_config = {**cfg.model_dump(mode="json"), "campaign": {"model": model, "objective": objective,
+                                                                 "method": method}}
+    table = run_campaign(problem, label, settings, context, store_config, client, _starts(cfg, setup))
+    found = distinct_optima(table, problem).rename(columns={"best_start": "start_id"})
+    flags: list[str] = []
+    for check in cfg.design.checks:
+        found, check_flags = check_optima(found, setup, names, label, context, check, client)
+        flags += check_flags
+    return table, found, flags
+
+
+def compute(config: CampaignStudyConfig, context: StudyContext) -> CampaignResult:
+    cfg = config
+    setups = cfg.setups()
+    names = [v.name for v in cfg.design.variables]
+    keys = [(m, o, meth) for m in setups for o in cfg.design.objectives for meth in cfg.design.methods]
+    check_stores(context, [campaign_label(*k) for k in keys])
+    tables: dict[tuple[str, str, str], pd.DataFrame] = {}
+    optima: dict[tuple[str, str, str], pd.DataFrame] = {}
+    rows = []
+    with dask_context(context) as client:
+        for key in keys:
+            tables[key], optima[key], flags = _campaign(cfg, setups[key[0]], key, context, client)
+            rows.append(_comparison_row(cfg, setups[key[0]], key, tables[key], optima[key], flags))
+        comparison = pd.DataFrame(rows)
+        sections = []
+        if cfg.report.before or cfg.tradeoffs or cfg.surfaces:
+            sections = [_model_sections(cfg, m, s, comparison, tables, "" if len(setups) == 1 else f"_{m}", client)
+                        for m, s in setups.items()]
+    starts = pd.concat([t.drop(columns=["functions"], errors="ignore").assign(model=m, objective=o, method=meth)
+                        for (m, o, meth), t in tables.items()], ignore_index=True)
+    optima_table = pd.concat([t.assign(model=m, objective=o, method=meth) for (m, o, meth), t in optima.items()],
+                             ignore_index=True)
+    return CampaignResult(cfg, comparison, starts, optima_table, _short(comparison, names),
+                          _frf_panels(cfg, setups, comparison), sections)

@@ -1,0 +1,3 @@
+"""Output service of the studies: the one table/figure writer, markdown, figures, publishing (no kind imports)."""
+
+__all__: list[str] = []
