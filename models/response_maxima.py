@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from railopt.models.modal import UNDAMPED_ROOT, growing_roots
+from railopt.models.modal import NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots
 from railopt.models.peak_search import cell_maxima
 from railopt.models.validation import band as validate_band
 from railopt.records import ArrayRecord
@@ -177,11 +177,17 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
         freqs = np.concatenate([clipped, edges])
         return {nm: ResponseMaxima(np.full(len(freqs), np.inf), freqs, wd, (lo, hi), exact=exact, certified=False,
                                    output=nm, evaluation="unstable", reason=reason) for nm in names}
+    # a band from 0 on a system with free rigid-body motion: the lower edge is the limit Ω → 0
+    lo_eval, at_zero = _zero_limit(system, names, cols, hi) if lo == 0.0 else (lo, None)
+    edges_eval = np.array([lo_eval, hi])
+    clipped_eval = np.clip(wd, lo_eval, hi)
     # an undamped mode inside the band has an unbounded peak, whatever rounding makes of Z(ω_d)
     resonant = system.undamped_modes() & (wd >= lo) & (wd <= hi)
     if not exact:
         freqs = np.concatenate([clipped, edges])
-        H = _finite_or_inf(np.abs(system.frf_outputs(freqs)))
+        H = _finite_or_inf(np.abs(system.frf_outputs(np.concatenate([clipped_eval, edges_eval]))))
+        if lo_eval > lo:  # the limit Ω → 0 at the lower edge (and at modes clipped to it)
+            H[np.concatenate([clipped_eval, edges_eval]) == lo_eval] = at_zero
         out = {}
         for nm, c in zip(names, cols, strict=True):
             vals = H[:, c].copy()
@@ -191,15 +197,23 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
 
     poles = system.modal().s
     poles = poles[np.abs(poles.real) > UNDAMPED_ROOT * np.abs(poles)]  # their cells are inf anyway
-    bounds = np.concatenate([[lo], 0.5 * (clipped[1:] + clipped[:-1]), [hi]])
+    if lo_eval > lo:  # the outputs have a finite limit at 0: the neutral poles are cancelled there
+        poles = poles[np.abs(poles) > NEUTRAL_ROOT * np.max(np.abs(system.modal().s))]
+    bounds = np.concatenate([[lo_eval], 0.5 * (clipped_eval[1:] + clipped_eval[:-1]), [hi]])
     max_delay = system.max_delay
-    grid, ratio = band_grid(poles, (lo, hi), max_delay=max_delay or 0.0, extra=np.concatenate([clipped, bounds]))
+    grid, ratio = band_grid(poles, (lo_eval, hi), max_delay=max_delay or 0.0,
+                            extra=np.concatenate([clipped_eval, bounds]))
     pr = system.pole_residue()
-    result = _exact_cells(system, pr, grid, bounds, cols, edges)
+    result = _exact_cells(system, pr, grid, bounds, cols, edges_eval)
     if result is None:  # pole–residue inconsistent with direct solves at a maximum: sample directly
         pr = None
-        result = _exact_cells(system, None, grid, bounds, cols, edges)
+        result = _exact_cells(system, None, grid, bounds, cols, edges_eval)
     cell_f, cell_x, all_finite, edge_vals = result
+    if lo_eval > lo:  # the limit Ω → 0: the lower edge's value, and the first cell's if it is larger
+        edge_vals[0] = at_zero
+        first = at_zero[cols]
+        larger = first > cell_f[:, 0]
+        cell_f[larger, 0], cell_x[larger, 0] = first[larger], lo_eval
     spacing = ratio <= CERTIFIED_RATIO * (1 + 1e-9)
     certified = bool(all_finite and max_delay is not None and spacing)
     reason = "" if certified else "; ".join(text for ok, text in (
@@ -211,12 +225,41 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
         f, x = cell_f[i].copy(), cell_x[i].copy()
         f[resonant] = np.inf
         x[resonant] = clipped[resonant]
+        x[x == lo_eval] = lo  # the limit Ω → 0 is reported at 0
         out[nm] = ResponseMaxima(
             np.concatenate([f, edge_vals[:, c]]), np.concatenate([x, edges]), wd, (lo, hi), exact=True,
             certified=certified, grid_ratio=ratio, output=nm,
             evaluation="direct" if pr is None else "pole-residue", grid_points=len(grid), reason=reason,
         )
     return out
+
+
+ZERO_STEP = 1.2e-4  # Ω = ZERO_STEP · (least non-neutral |s|) and 2Ω extrapolate H to Ω → 0 when Z(0) is singular
+
+
+def _zero_limit(system: LinearSystem, names: list[str], cols: list[int], hi: float) -> tuple[float, np.ndarray]:
+    """For a band from 0 Hz: ``(lower edge to sample, |H(0)| per output column)``.
+
+    Without free rigid-body roots the edge is 0 itself.  With them (s = 0, Z(0) singular) every output must
+    have a finite limit at 0 (the poles at the origin cancel, e.g. the acceleration of a free body): H is
+    sampled at ε = 1.2e-4·|s_min| (rounding of the nearly singular solve ~ε_mach/1.2e-4² ≈ 1e-8 relative) and
+    2ε, and the limit is the linear extrapolation 2H(ε) − H(2ε) (error O(ε²)).  An output that grows as Ω → 0
+    (the displacement of a free body under a force) is truly unbounded: its band is refused naming ``band``.
+    """
+    s = system.eigenvalues()
+    scale = float(np.max(np.abs(s))) if s.size else 0.0
+    neutral = np.abs(s) <= NEUTRAL_ROOT * scale
+    if scale == 0.0 or not np.any(neutral):
+        return 0.0, None
+    eps = min(ZERO_STEP * float(np.min(np.abs(s[~neutral]))), 1e-3 * hi)
+    H = system.frf_outputs(np.array([eps, 2 * eps, 0.1 * eps]))
+    mags = np.abs(H)[:, cols]
+    growing = ~np.isfinite(mags[2]) | (mags[2] > 1.5 * mags[0] + 1e-300)
+    if np.any(growing):
+        bad = [nm for nm, g in zip(names, growing, strict=True) if g]
+        raise ValueError(f"band: starts at 0 Hz, where the output(s) {bad} are unbounded (free rigid-body motion: "
+                         "Z(0) is singular and the response grows as Ω → 0); start the band above 0")
+    return eps, np.abs(2 * H[0] - H[1])
 
 
 def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray, cols: list[int],

@@ -83,7 +83,8 @@ def spectral_abscissa(system: LinearSystem | object, speed: float | None = None,
 
 def _speeds(speeds: object, name: str = "speeds") -> np.ndarray:
     try:
-        values = [number(f"{name}[{i}]", s, positive=True) for i, s in enumerate(np.atleast_1d(speeds))]
+        items = list(speeds) if isinstance(speeds, Sequence | np.ndarray) and not isinstance(speeds, str) else [speeds]
+        values = [number(f"{name}[{i}]", s, positive=True) for i, s in enumerate(items)]
     except ValueError as exc:
         raise ValueError(f"{exc} (forward speeds in m/s)") from None
     if not values:

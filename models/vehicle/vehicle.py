@@ -11,6 +11,7 @@ import numpy as np
 from railopt.models.track.beam import Beam
 from railopt.models.track.lumped import LumpedTrack, lumped
 from railopt.models.units import GRAVITY
+from railopt.models.validation import number
 from railopt.models.vehicle.assembly import TRACKS, Assembly, assemble
 from railopt.models.vehicle.bodies import Body
 from railopt.models.vehicle.constraints import check_reduced_mass
@@ -115,12 +116,11 @@ class Vehicle:
         """A changed copy.  Names: element ids and aliases, ``<body>.mass``, ``<body>.Ixx|Iyy|Izz``,
         contact (conicity, wheel_radius, semi_gauge, theta0, epsilon, eta, creep_factor, axle_load,
         f11, f22, f23, f33), track (track_modulus, track_damping_ratio) and the file's aliases."""
+        if not isinstance(values, Mapping):
+            raise ValueError(f"values: must be a mapping of parameter names to numbers, got {type(values).__name__}")
         v = self
         for name, value in values.items():
-            value = float(value)
-            if not math.isfinite(value):
-                raise ValueError(f"{name}: value must be finite, got {value!r}")
-            v = v._with_one(name, value)
+            v = v._with_one(name, number(str(name), value))
         return v
 
     def _with_one(self, name: str, value: float) -> Vehicle:
