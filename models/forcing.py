@@ -194,8 +194,18 @@ class Forcing:
         return np.asarray(total, dtype=complex)
 
     def values(self, omegas: np.ndarray) -> np.ndarray:
-        """``F(Ω)`` at many frequencies, shape (len(omegas), n)."""
-        return np.array([self.value(float(w)) for w in np.ravel(omegas)], dtype=complex)
+        """``F(Ω)`` at many frequencies, shape (len(omegas), n); polynomial terms vectorised over Ω."""
+        w = np.asarray(omegas, dtype=float).ravel()
+        if not self.is_polynomial:
+            return np.array([self.value(float(x)) for x in w], dtype=complex)
+        iw = 1j * w
+        total = None
+        for t in self.terms:
+            part = (iw[:, None] ** np.arange(t.coefficients.shape[0])[None, :]) @ t.coefficients
+            if t.delay != 0.0:
+                part *= np.exp(-1j * w * t.delay)[:, None]
+            total = part if total is None else total + part
+        return total
 
     def derivative(self, omega: float) -> np.ndarray:
         """``dF/dΩ``: exact for polynomial terms and delays; callables by a central difference

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from railopt.models.forcing import DistanceForcing, Forcing, ForcingLike, as_forcing, at_speed
+from railopt.models.forcing import DelayedTerm, DistanceForcing, Forcing, ForcingLike, as_forcing, at_speed
 from railopt.models.system import LinearSystem, Output, Tangent
 from railopt.models.validation import number, real_array
 
@@ -47,7 +47,7 @@ def affine(base: np.ndarray, parts: np.ndarray, p: np.ndarray) -> np.ndarray:
     ``base`` (…), ``parts`` (P, …), ``p`` (P,).  Used for M, C, K of every family member and for the
     input matrices of vehicle views.
     """
-    acc = np.zeros(np.shape(base))
+    acc = np.zeros(np.shape(base), dtype=np.result_type(base, parts))
     for pi, part in zip(p, parts, strict=True):  # in parameter order: exact cancellations stay exact
         if pi != 0.0:
             acc += pi * part
@@ -230,8 +230,31 @@ class ParametricSystem:
                 outputs[k] = Output(o.row, o.quantity, feed.at_speed(speed))
             if len(self._at_speed_cache) > 64:
                 self._at_speed_cache.clear()
-            self._at_speed_cache[speed] = (F0, Fs, Fp, outputs)
+            self._at_speed_cache[speed] = (F0, Fs, Fp, outputs, self._forcing_plan(speed, F0, Fs, Fp))
         return self._at_speed_cache[speed]
+
+    def _forcing_plan(self, speed: float | None, F0, Fs, Fp) -> list[tuple[float, np.ndarray, np.ndarray]] | None:
+        """For polynomial forcings: per distinct delay, the constant coefficients and the (P, J, n) stack of the
+        parameters' coefficients, so a member's F(p) is one :func:`affine` per delay (None: callable terms)."""
+        forcings = [f for f in (F0, Fs, *Fp) if f is not None]
+        if not all(f.is_polynomial for f in forcings):
+            return None
+        delays = sorted({t.delay for f in forcings for t in f.terms})
+        J = max((t.coefficients.shape[0] for f in forcings for t in f.terms), default=1)
+        n, P = self.n, len(self.parameters)
+        plan = []
+        for d in delays:
+            base, stack = np.zeros((J, n), dtype=complex), np.zeros((P, J, n), dtype=complex)
+            for weight, f, target in [(1.0, F0, base), (None if speed is None else 1.0 / speed, Fs, base)]:
+                for t in (f.terms if f is not None else ()):
+                    if t.delay == d:
+                        target[: t.coefficients.shape[0]] += weight * t.coefficients
+            for i, f in enumerate(Fp):
+                for t in (f.terms if f is not None else ()):
+                    if t.delay == d:
+                        stack[i, : t.coefficients.shape[0]] += t.coefficients
+            plan.append((d, base, stack))
+        return plan
 
     def _forcing(self, p: np.ndarray, speed: float | None, F0, Fs, Fp) -> Forcing:
         weighted = [(1.0, F0)] if F0 is not None else []
@@ -263,11 +286,16 @@ class ParametricSystem:
         if self._C_speed is not None:
             C = C + self._C_speed / speed
             dC_dspeed = -self._C_speed / speed**2
-        F0, Fs, Fp, outputs = self._speed_parts(speed)
+        F0, Fs, Fp, outputs, plan = self._speed_parts(speed)
         tangent = Tangent(self.parameters, p, self._M, self._C, self._K, tuple(Fp), speed, dC_dspeed,
                           self._speed_derivative(p, speed) if speed is not None else None)
-        return LinearSystem._trusted(affine(b.M, self._M, p), C, affine(b.K, self._K, p),
-                                     self._forcing(p, speed, F0, Fs, Fp), outputs, b.names, tangent)
+        if plan is None:
+            forcing = self._forcing(p, speed, F0, Fs, Fp)
+        else:
+            forcing = Forcing(terms=[DelayedTerm(d, coefficients=affine(base, stack, p)) for d, base, stack in plan]
+                              or [DelayedTerm(0.0, coefficients=np.zeros((1, self.n), dtype=complex))])
+        return LinearSystem._trusted(affine(b.M, self._M, p), C, affine(b.K, self._K, p), forcing, outputs,
+                                     b.names, tangent)
 
     def _speed_derivative(self, p: np.ndarray, speed: float):
         """``Ω -> ∂F/∂S`` at (p, S): the delays d/S and the F_speed/S term of every distance forcing."""

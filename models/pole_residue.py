@@ -99,7 +99,7 @@ class PoleResidue:
             H += ((P * BA) @ self._Cv.T) * np.exp(-1j * w * t.delay)[:, None]
         for o, d in enumerate(self._feedthroughs):  # the input's own part of the output: no poles
             if d is not None:
-                H[:, o] += np.array([d.value(float(x))[0] for x in w], dtype=complex)
+                H[:, o] += d.values(w)[:, 0]
         with np.errstate(invalid="ignore", over="ignore"):
             H *= iw[:, None] ** self.orders[None, :]
         H[~np.isfinite(H)] = np.inf

@@ -52,7 +52,7 @@ class Output:
         w = np.asarray(omega, dtype=float).ravel()
         if self.feedthrough is None:
             return np.zeros(len(w), dtype=complex)
-        return np.array([self.feedthrough.value(float(x))[0] for x in w], dtype=complex)
+        return self.feedthrough.values(w)[:, 0]
 
 
 def _output(name: str, spec: object, n: int) -> Output:
