@@ -155,7 +155,8 @@ def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str,
                  "converged": int(table["success"].sum()), "success_rate": float(table["success"].mean()),
                  "distinct_optima": len(optima), "evaluations": int(table["evaluations"].sum()),
                  "wall_time_s": float(table["wall_time"].sum())}
-    row["all_optima_pass_checks"] = bool(optima[flags].all().all()) if flags else None
+    flags = [f for f in flags if f in optima.columns]  # no optima: no check columns
+    row["all_optima_pass_checks"] = bool(optima[flags].all().all()) if flags and len(optima) else None
     if len(ok):
         best = ok.sort_values(["value", "start_id"]).iloc[0]
         values = {n: float(best[n]) for n in names}
