@@ -55,9 +55,7 @@ def _num(value: Any) -> float | str:
     if isinstance(value, bool) or not isinstance(value, int | float | str):
         raise ValueError(f"expected a number or an arithmetic expression, got {_short(value)}")
     if isinstance(value, str):
-        if len(value) > MAX_EXPRESSION:
-            raise ValueError(f"cannot evaluate {_short(value)} (expression longer than {MAX_EXPRESSION} characters)")
-        return value
+        return value  # evaluated (and bounded to MAX_EXPRESSION characters) by the loader, which names the item
     try:
         return float(value)
     except OverflowError:
@@ -306,6 +304,7 @@ TABLES: dict[str, type[Strict]] = {
     "angles_deg": LengthSchema,
 }
 ARRAYS = ("bodies", "elements", "constraints")
+MISSING_HINTS = {"kind": ' (kind = "body" or "wheelset": a wheelset gets wheel/rail contact)'}
 
 
 # ---------------------------------------------------------------------------------------------- errors
@@ -340,11 +339,11 @@ def key_path(data: Mapping[str, Any], loc: Sequence[Any]) -> str:
     return out or "(top level)"
 
 
-def _allowed(loc: Sequence[Any]) -> list[str]:
-    """Keys allowed where an unknown key was found (the model of the enclosing table)."""
-    if len(loc) == 1:
+def _allowed(table: Sequence[Any]) -> list[str]:
+    """Keys allowed in ``table`` (a location without the unknown key; ``[]`` for the top level)."""
+    if not table:
         return list(VehicleFileSchema.model_fields)
-    model = TABLES.get(loc[0])
+    model = TABLES.get(table[0])
     return list(model.model_fields) if model is not None else []
 
 
@@ -365,17 +364,16 @@ def format_errors(data: Mapping[str, Any], exc: ValidationError) -> str:
             where = key_path(data, loc[:-1])
             table = loc[:-1]
             if not table:
-                lines.append(f"[{key}]: unknown table or key{did_you_mean(key, _allowed([key]))}")
+                lines.append(f"{key}: unknown table or key at the top level{did_you_mean(key, _allowed([]))}")
                 continue
-            allowed = _allowed(table if table[0] not in ARRAYS else [table[0], 0])
-            lines.append(f"{where}.{key}: unknown key{did_you_mean(key, allowed)}")
+            lines.append(f"{where}.{key}: unknown key{did_you_mean(key, _allowed(table))}")
         elif err["type"] == "missing":
             where = key_path(data, loc[:-1])
             if len(loc) == 1:
                 lines.append(f"missing [{loc[0]}] table" if loc[0] != "bodies" else
                              "missing [[bodies]]: a vehicle needs at least one body")
             else:
-                lines.append(f"{where}: missing {loc[-1]}")
+                lines.append(f"{where}: missing {loc[-1]}{MISSING_HINTS.get(loc[-1], '')}")
         elif err["type"] in ("list_type", "model_type", "dict_type") and len(loc) == 1:
             kind = "an array of tables [[...]]" if loc[0] in ARRAYS else "a table"
             lines.append(f"[{loc[0]}] must be {kind}, got {_short(err.get('input'))}")
