@@ -85,7 +85,7 @@ def evaluate(value: Any, names: Mapping[str, float], what: str) -> float:
             x = float(_eval(ast.parse(value.strip(), mode="eval").body, names, 0))
         except _FAULTS as exc:
             reason = {OverflowError: "result out of range", RecursionError: "nested too deeply",
-                      MemoryError: "too large"}.get(type(exc)) or str(exc).strip("'\"") or type(exc).__name__
+                      MemoryError: "too large"}.get(type(exc)) or str(exc.args[0] if exc.args else exc)
             raise ValueError(f"{what}: cannot evaluate {_short(value)} ({reason})") from None
     else:
         raise ValueError(f"{what}: expected a number or an expression, got {_short(value)}")
