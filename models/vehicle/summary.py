@@ -272,20 +272,33 @@ def vehicle_summary(vehicle: Vehicle, speed: float | None = None, track: str = "
                           modes=modes, critical=critical, warnings=plausibility(vehicle))
 
 
+class _UsageError(Exception):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    """Argument errors come back as text (the CLI prints them), not on stderr."""
+
+    def error(self, message: str):  # noqa: D102
+        raise _UsageError(f"{self.format_usage().rstrip()}\n{self.prog}: error: {message}")
+
+
 def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
     """``railopt vehicle NAME_OR_FILE [--speed S] [--track rigid|flexible] [--markdown]``: the report and the exit
     code (0; 2 for a file error, with the message ``<file>: <key path>: <what>``)."""
     from railopt.models.vehicle.loader import load_vehicle
 
-    parser = argparse.ArgumentParser(prog="railopt vehicle", description="Summary of a vehicle file.")
+    parser = _Parser(prog="railopt vehicle", description="Summary of a vehicle file.")
     parser.add_argument("vehicle", help="bundled name (sd40-2, manchester-coach, single-wheelset) or a .toml file")
     parser.add_argument("--speed", type=float, default=None, help="speed of the modes table, m/s (default 20)")
     parser.add_argument("--track", choices=("rigid", "flexible"), default="rigid")
     parser.add_argument("--markdown", action="store_true", help="Markdown instead of plain text")
     try:
         args = parser.parse_args(list(argv))
-    except SystemExit as exc:
-        return parser.format_usage(), int(exc.code or 0)
+    except _UsageError as exc:
+        return str(exc), 2
+    except SystemExit:  # --help
+        return parser.format_help(), 0
     try:
         summary = vehicle_summary(load_vehicle(args.vehicle), speed=args.speed, track=args.track)
     except ValueError as exc:
