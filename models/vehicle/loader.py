@@ -349,7 +349,8 @@ def _constraint(i: int, c: Any, names: Mapping[str, float], known: set[str]) -> 
 def _num(t: Any, key: str, names: Mapping[str, float], table: str, positive: bool = False,
          lower: float | None = None, upper: float | None = None) -> float:
     what = f"{table}.{key}"
-    x = evaluate(getattr(t, key), names, what) if getattr(t, key) != math.inf else math.inf
+    raw = getattr(t, key)
+    x = math.inf if key == "wheel_transverse_radius_m" and raw == math.inf else evaluate(raw, names, what)
     if positive and not x > 0.0:
         raise ValueError(f"{what}: must be positive, got {x!r}")
     if lower is not None and x < lower:

@@ -254,3 +254,12 @@ def test_vehicle_repr_is_short() -> None:
     r = repr(load_vehicle("sd40-2"))
     assert len(r) < 500
     assert r.startswith("Vehicle('sd40-2', 15 bodies (6 wheelsets), 116 elements (27 parameters), 166,922 kg, contact")
+
+
+def test_infinite_values_refused_except_a_coned_tread(tmp_path: Path) -> None:
+    refused(tmp_path, COACH, "youngs_modulus_Pa = 2.1e11", "youngs_modulus_Pa = inf",
+            r": contact\.youngs_modulus_Pa: must be finite, got inf")
+    path = tmp_path / "coned.toml"
+    path.write_text(COACH.replace("rail_head_radius_m = 0.3",
+                                  "rail_head_radius_m = 0.3\nwheel_transverse_radius_m = inf"))
+    assert load_vehicle(path).contact.wheel_transverse_radius == float("inf")
