@@ -1,9 +1,12 @@
-"""Read and validate vehicle files (TOML); schema in ``docs/vehicle.md``.
+"""Read and validate vehicle files (TOML); schema in ``docs/vehicle.md`` and :mod:`.schema`.
 
-Numbers in ``cg_m``, ``point_m``, ``point_a_m``, ``point_b_m`` and ``direction`` may be strings
-with arithmetic over the file's ``[lengths]`` and ``[angles_deg]`` names (``"l3 + l16"``,
-``"cos(alpha1)"``), so the file reads like the thesis's geometry.  Every error is a
-:class:`VehicleFileError` naming the item and the file; nothing is written anywhere.
+Numbers in ``cg_m``, ``point_m``, ``point_a_m``, ``point_b_m``, ``direction``, masses, inertias and
+contact values may be strings with arithmetic over the file's ``[lengths]`` and ``[angles_deg]`` names
+(``"l3 + l16"``, ``"cos(alpha1)"``), so the file reads like the thesis's geometry.  The shape of the
+file (tables, keys, types) is checked by :func:`railopt.models.vehicle.schema.validate_file`; values
+after evaluation here.  Every error is one :class:`VehicleFileError` ``<file>: <key path>: <what>``;
+nothing is written anywhere.  Warnings about values that load but look wrong (units, magnitudes):
+:func:`railopt.models.vehicle.plausibility.plausibility`.
 """
 
 from __future__ import annotations
@@ -17,63 +20,127 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from railopt.models.vehicle.bodies import KINDS, Body
-from railopt.models.vehicle.elements import ELEMENT_TYPES, GROUND, VALUE_KEYS, Element
+import numpy as np
+
+from railopt.models.vehicle.bodies import Body
+from railopt.models.vehicle.elements import GROUND, Element
+from railopt.models.vehicle.schema import (
+    MAX_EXPRESSION,
+    VALUE_KEYS,
+    BodySchema,
+    ContactSchema,
+    ElementSchema,
+    LengthSchema,
+    TrackSchema,
+    VehicleFileSchema,
+    did_you_mean,
+    validate_file,
+)
 from railopt.models.vehicle.spec import ConstraintSpec, ContactSpec, Lengths, TrackSpec
 from railopt.models.vehicle.vehicle import Vehicle
 from railopt.models.vehicle.wheelrail import Creep
 
 BUNDLED = ("sd40-2", "single-wheelset", "manchester-coach")
+MAX_DEPTH = 32  # nesting of an arithmetic expression
+INERTIA_RTOL = 1e-9  # eigenvalues of an inertia tensor below this fraction of the largest count as zero
 
 
 class VehicleFileError(ValueError):
     """A vehicle file is invalid; the message names the item and the file."""
 
 
+def _pow(a: float, b: float) -> float:
+    return math.pow(a, b)  # float power: OverflowError or a domain ValueError, never a complex or a huge int
+
+
 _BINOPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
-           ast.Pow: operator.pow}
+           ast.Pow: _pow}
 _FUNCS = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "sqrt": math.sqrt, "radians": math.radians}
+_FAULTS = (SyntaxError, KeyError, TypeError, ZeroDivisionError, OverflowError, RecursionError, MemoryError, ValueError)
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def evaluate(value: Any, names: Mapping[str, float], what: str) -> float:
-    """A number, or an arithmetic string over ``names`` (+ − × ÷ **, sin, cos, tan, sqrt, radians)."""
+    """A number, or an arithmetic string over ``names`` (+ − × ÷ **, sin, cos, tan, sqrt, radians).
+
+    Raises a ``ValueError`` naming ``what`` for anything else: an unknown name, a result that is not finite,
+    an overflow (``"10.0 ** 400"``), a math domain error (``"sqrt(-1)"``), an expression longer than 200
+    characters or nested deeper than 32 levels.
+    """
     if isinstance(value, bool):
         raise ValueError(f"{what}: expected a number, got {value!r}")
     if isinstance(value, int | float):
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:
+            raise ValueError(f"{what}: number out of range {_short(value)}") from None
     elif isinstance(value, str):
         try:
-            x = float(_eval(ast.parse(value, mode="eval").body, names))
-        except (SyntaxError, KeyError, TypeError, ZeroDivisionError) as exc:
-            raise ValueError(f"{what}: cannot evaluate {value!r} ({exc})") from None
+            if len(value) > MAX_EXPRESSION:
+                raise ValueError(f"expression longer than {MAX_EXPRESSION} characters")
+            x = float(_eval(ast.parse(value.strip(), mode="eval").body, names, 0))
+        except _FAULTS as exc:
+            reason = {OverflowError: "result out of range", RecursionError: "nested too deeply",
+                      MemoryError: "too large"}.get(type(exc)) or str(exc.args[0] if exc.args else exc)
+            raise ValueError(f"{what}: cannot evaluate {_short(value)} ({reason})") from None
     else:
-        raise ValueError(f"{what}: expected a number or an expression, got {value!r}")
+        raise ValueError(f"{what}: expected a number or an expression, got {_short(value)}")
     if not math.isfinite(x):
-        raise ValueError(f"{what}: must be finite, got {value!r}")
+        raise ValueError(f"{what}: must be finite, got {_short(value)}")
     return x
 
 
-def _eval(node: ast.AST, names: Mapping[str, float]) -> float:
+def _eval(node: ast.AST, names: Mapping[str, float], depth: int) -> float:
+    if depth > MAX_DEPTH:
+        raise ValueError(f"nested deeper than {MAX_DEPTH} levels")
     if isinstance(node, ast.Constant) and isinstance(node.value, int | float) and not isinstance(node.value, bool):
-        return node.value
+        return float(node.value)
     if isinstance(node, ast.Name):
         if node.id not in names:
-            raise KeyError(f"unknown length or angle {node.id!r}")
+            raise KeyError(f"unknown length or angle {node.id!r}{did_you_mean(node.id, list(names))}")
         return names[node.id]
     if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
-        return _BINOPS[type(node.op)](_eval(node.left, names), _eval(node.right, names))
+        return _BINOPS[type(node.op)](_eval(node.left, names, depth + 1), _eval(node.right, names, depth + 1))
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
-        x = _eval(node.operand, names)
+        x = _eval(node.operand, names, depth + 1)
         return -x if isinstance(node.op, ast.USub) else x
-    call = isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and len(node.args) == 1
+    call = (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and len(node.args) == 1
+            and not node.keywords)
     if call and node.func.id in _FUNCS:
-        return _FUNCS[node.func.id](_eval(node.args[0], names))
+        return _FUNCS[node.func.id](_eval(node.args[0], names, depth + 1))
     raise TypeError(f"unsupported expression element {ast.dump(node)[:40]}")
 
 
 def bundled_path(name: str) -> Path:
     """Path of a bundled vehicle file (``"sd40-2"``, ``"single-wheelset"``, ``"manchester-coach"``)."""
     return Path(str(resources.files("railopt.models.vehicle") / "data" / f"{name}.toml"))
+
+
+def read_vehicle_file(name_or_path: str | Path) -> tuple[dict[str, Any], str]:
+    """The parsed TOML of a bundled name or a path, and the path as text (errors name the file)."""
+    if isinstance(name_or_path, str) and name_or_path in BUNDLED:
+        path = bundled_path(name_or_path)
+    else:
+        path = Path(name_or_path)
+        if not path.is_file():
+            raise VehicleFileError(f"{name_or_path}: no such vehicle file; bundled vehicles: {', '.join(BUNDLED)}")
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise VehicleFileError(f"{path}: cannot read vehicle file ({exc.strerror or exc})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise VehicleFileError(f"{path}: not a text file (byte {exc.start} is not UTF-8); a vehicle file is TOML") \
+            from None
+    try:
+        return tomllib.loads(text), str(path)
+    except (tomllib.TOMLDecodeError, ValueError, RecursionError) as exc:
+        raise VehicleFileError(f"{path}: cannot read vehicle file ({exc})") from None
 
 
 def load_vehicle(name_or_path: str | Path, lengths: Mapping[str, float] | None = None) -> Vehicle:
@@ -89,64 +156,48 @@ def load_vehicle(name_or_path: str | Path, lengths: Mapping[str, float] | None =
     Raises
     ------
     VehicleFileError
-        Unknown name, unreadable file or invalid content (the message names the item and file).
+        Unknown name, unreadable or non-UTF-8 file, or invalid content: ``<file>: <key path>: <what>``.
     """
-    if isinstance(name_or_path, str) and name_or_path in BUNDLED:
-        path = bundled_path(name_or_path)
-    else:
-        path = Path(name_or_path)
-        if not path.is_file():
-            raise VehicleFileError(f"{name_or_path}: no such vehicle file; bundled vehicles: {', '.join(BUNDLED)}")
+    data, path = read_vehicle_file(name_or_path)
+    return parse_vehicle(data, path, lengths)
+
+
+def parse_vehicle(data: Mapping[str, Any], path: str = "<memory>",
+                  length_overrides: Mapping[str, float] | None = None) -> Vehicle:
+    """Build a :class:`Vehicle` from parsed TOML ``data``.
+
+    Raises
+    ------
+    VehicleFileError
+        ``<path>: <key path>: <what>`` (a ``ValueError``).
+    """
     try:
-        data = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise VehicleFileError(f"{path}: cannot read vehicle file ({exc})") from None
-    try:
-        return parse_vehicle(data, str(path), lengths)
+        return _parse(data, path, length_overrides)
     except VehicleFileError:
         raise
     except ValueError as exc:
         raise VehicleFileError(f"{path}: {exc}") from None
 
 
-def _table(data: Mapping[str, Any], key: str, required: bool = True) -> dict[str, Any]:
-    t = data.get(key)
-    if t is None:
-        if required:
-            raise ValueError(f"missing [{key}] table")
-        return {}
-    if not isinstance(t, dict):
-        raise ValueError(f"[{key}] must be a table")
-    return t
-
-
-def _named_values(table: Mapping[str, Any], what: str) -> tuple[dict[str, float], dict[str, str]]:
-    values, sources = {}, {}
-    for k, v in table.items():
-        if isinstance(v, dict):
-            sources[k] = str(v.get("source", "estimate"))
-            v = v.get("value")
-        values[k] = evaluate(v, {}, f"{what}.{k}")
-    return values, sources
-
-
-def parse_vehicle(data: Mapping[str, Any], path: str = "<memory>",
-                  length_overrides: Mapping[str, float] | None = None) -> Vehicle:
-    """Build a :class:`Vehicle` from parsed TOML ``data`` (errors raise ValueError naming the item)."""
-    head = _table(data, "vehicle")
-    name = str(head.get("name", Path(path).stem))
-    lengths, lsources = _named_values(_table(data, "lengths", required=False), "lengths")
+def _parse(data: Mapping[str, Any], path: str, length_overrides: Mapping[str, float] | None) -> Vehicle:
+    f = validate_file(data)
+    name = f.vehicle.name or Path(path).stem
+    lengths, lsources = _named_values(f.lengths, "lengths")
     for k, v in (length_overrides or {}).items():
         if k not in lengths:
-            raise ValueError(f"lengths: unknown override {k!r}; defined: {sorted(lengths)}")
+            raise ValueError(f"lengths: unknown override {k!r}{did_you_mean(k, list(lengths))}; "
+                             f"defined: {sorted(lengths)}")
         lengths[k] = evaluate(v, {}, f"lengths.{k}")
-    angles, _ = _named_values(_table(data, "angles_deg", required=False), "angles_deg")
+    angles, _ = _named_values(f.angles_deg, "angles_deg")
+    clash = sorted(set(lengths) & set(angles))
+    if clash:
+        raise ValueError(f"angles_deg.{clash[0]}: also defined in [lengths]")
     names = dict(lengths)
     names.update({k: math.radians(v) for k, v in angles.items()})
 
-    bodies = [_body(i, b, names) for i, b in enumerate(_list(data, "bodies"))]
-    if not bodies:
+    if not f.bodies:
         raise ValueError("no [[bodies]]: a vehicle needs at least one body")
+    bodies = [_body(i, b, names) for i, b in enumerate(f.bodies)]
     body_names = [b.name for b in bodies]
     dup = {n for n in body_names if body_names.count(n) > 1}
     if dup:
@@ -154,176 +205,235 @@ def parse_vehicle(data: Mapping[str, Any], path: str = "<memory>",
     known = set(body_names)
 
     elements: list[Element] = []
-    for i, e in enumerate(_list(data, "elements", required=False)):
-        el, mirror = _element(i, e, names, known)
-        elements.append(el)
-        if mirror:
-            elements.append(el.mirrored_y())
-    values: dict[str, float] = {}
-    for e in elements:
-        if values.setdefault(e.id, e.value) != e.value:
-            raise ValueError(f"elements: id {e.id!r} given two values ({values[e.id]} and {e.value})")
+    for i, e in enumerate(f.elements):
+        elements += _element(i, e, names, known)
+    _check_ids(f, elements)
 
-    constraints = [_constraint(i, c, names, known) for i, c in enumerate(_list(data, "constraints", required=False))]
-    contact = _contact(_table(data, "contact", required=False), names)
+    constraints = [_constraint(i, c, names, known) for i, c in enumerate(f.constraints)]
+    contact = _contact(f.contact, names)
     if contact is None and any(b.kind == "wheelset" for b in bodies):
         raise ValueError("missing [contact] table: the vehicle has wheelsets")
-    track = _track(_table(data, "track", required=False))
-    cab = _table(data, "cab", required=False)
-    cab_point = _vector(cab["point_m"], names, "cab.point_m") if "point_m" in cab else None
+    track = _track(f.track, names)
+    cab_point = _vector(f.cab.point_m, names, "cab.point_m") if f.cab is not None else None
 
-    vehicle = Vehicle(name=name, description=str(head.get("description", "")), bodies=tuple(bodies),
+    vehicle = Vehicle(name=name, description=f.vehicle.description, bodies=tuple(bodies),
                       elements=tuple(elements), constraints=tuple(constraints), contact=contact, track=track,
                       cab_point=cab_point, lengths=Lengths(lengths, lsources), aliases={}, path=path)
-    aliases = {str(k): str(v) for k, v in _table(data, "aliases", required=False).items()}
-    valid = set(vehicle.parameter_names())
-    for k, v in aliases.items():
-        if v not in valid:
-            raise ValueError(f"aliases.{k}: unknown parameter {v!r}; valid: {', '.join(sorted(valid))}")
-    return Vehicle(**{**vehicle.__dict__, "aliases": aliases, "_cache": {}})
+    _check_aliases(vehicle, f.aliases)
+    vehicle = Vehicle(**{**vehicle.__dict__, "aliases": dict(f.aliases), "_cache": {}})
+    _check_contact(vehicle)
+    return vehicle
 
 
-def _list(data: Mapping[str, Any], key: str, required: bool = True) -> list[dict[str, Any]]:
-    v = data.get(key, [])
-    if not isinstance(v, list) or not all(isinstance(x, dict) for x in v):
-        raise ValueError(f"[[{key}]] must be an array of tables")
-    if required and not v:
-        raise ValueError(f"missing [[{key}]]")
-    return v
+def _named_values(table: Mapping[str, Any], what: str) -> tuple[dict[str, float], dict[str, str]]:
+    values, sources = {}, {}
+    for k, v in table.items():
+        if not k.isidentifier() or k in _FUNCS:
+            raise ValueError(f"{what}.{k}: a name must be an identifier other than {sorted(_FUNCS)}")
+        if isinstance(v, LengthSchema):
+            sources[k] = v.source
+            v = v.value
+        values[k] = evaluate(v, {}, f"{what}.{k}")
+    return values, sources
 
 
 def _vector(v: Any, names: Mapping[str, float], what: str) -> tuple[float, float, float]:
-    if not isinstance(v, list) or len(v) != 3:
-        raise ValueError(f"{what}: expected 3 values [x, y, z], got {v!r}")
     return tuple(evaluate(x, names, f"{what}[{i}]") for i, x in enumerate(v))
 
 
-def _number(t: Mapping[str, Any], key: str, what: str, default: float | None = None, positive: bool = False,
-            names: Mapping[str, float] | None = None) -> float:
-    if key not in t:
-        if default is None:
-            raise ValueError(f"{what}: missing {key}")
-        return default
-    x = evaluate(t[key], names or {}, f"{what}.{key}")
-    if positive and x <= 0.0:
-        raise ValueError(f"{what}.{key}: must be positive, got {x!r}")
+def _body(i: int, b: BodySchema, names: Mapping[str, float]) -> Body:
+    label = f"bodies[{i}] ({b.name})"
+    mass = evaluate(b.mass_kg, names, f"{label}.mass_kg")
+    if mass <= 0.0:
+        raise ValueError(f"{label}: mass_kg must be positive, got {mass!r}")
+    what = f"{label}.inertia_kg_m2"
+    if isinstance(b.inertia_kg_m2[0], tuple):
+        tensor = np.array([[evaluate(x, names, f"{what}[{r}][{c}]") for c, x in enumerate(row)]
+                           for r, row in enumerate(b.inertia_kg_m2)])
+        if not np.allclose(tensor, tensor.T, rtol=1e-12, atol=0.0):
+            raise ValueError(f"{what}: not symmetric (Ixy, Ixz, Iyz must equal Iyx, Izx, Izy)")
+    else:
+        tensor = np.diag([evaluate(x, names, f"{what}[{k}]") for k, x in enumerate(b.inertia_kg_m2)])
+    if np.any(np.diag(tensor) < 0.0):
+        raise ValueError(f"{what}: must be >= 0 on the diagonal, got {np.diag(tensor).tolist()}")
+    eig = np.linalg.eigvalsh(tensor)
+    scale = float(np.max(np.abs(eig)))
+    if eig[0] < -INERTIA_RTOL * scale:
+        raise ValueError(f"{what}: not positive semi-definite (principal moments {_moments(eig)} kg m^2; "
+                         "a product of inertia exceeds what the moments allow, e.g. Ixz^2 > Ixx Izz)")
+    if eig[0] <= INERTIA_RTOL * scale:
+        raise ValueError(f"{what}: singular inertia tensor (principal moments {_moments(eig)} kg m^2): every "
+                         "rotation of a body needs inertia")
+    inertia = tuple(map(tuple, tensor)) if isinstance(b.inertia_kg_m2[0], tuple) else tuple(np.diag(tensor))
+    return Body(b.name, mass, inertia, _vector(b.cg_m, names, f"{label}.cg_m"), b.kind, b.source)
+
+
+def _moments(eig: np.ndarray) -> str:
+    return "[" + ", ".join(f"{x:.4g}" for x in eig) + "]"
+
+
+def _element(i: int, e: ElementSchema, names: Mapping[str, float], known: set[str]) -> list[Element]:
+    label = f"elements[{i}] ({e.id})"
+    for key in ("body_a", "body_b"):
+        b = getattr(e, key)
+        if b != GROUND and b not in known:
+            raise ValueError(f"{label}: {key} {b!r} is not a body{did_you_mean(b, sorted(known) + [GROUND])} "
+                             f"(bodies: {sorted(known)}, or 'ground')")
+    if e.body_a == GROUND:
+        raise ValueError(f"{label}: body_a must be a body ('ground' only as body_b)")
+    if e.body_a == e.body_b:
+        raise ValueError(f"{label}: body_a and body_b are both {e.body_a!r}")
+    key = f"{label}.{VALUE_KEYS[e.type]}"
+    value = evaluate(e.value, names, key)
+    if value < 0.0:
+        raise ValueError(f"{key}: must be >= 0, got {value!r}")
+    pa = _vector(e.point_a_m, names, f"{label}.point_a_m")
+    pb = _vector(e.point_b_m, names, f"{label}.point_b_m")
+    try:
+        el = Element(id=e.id, alias=e.alias, type=e.type, body_a=e.body_a, point_a=pa, body_b=e.body_b, point_b=pb,
+                     direction=_vector(e.direction, names, f"{label}.direction"), value=value, source=e.source)
+    except ValueError as exc:
+        raise ValueError(f"{label}: {exc}") from None
+    if not e.mirror_y:
+        return [el]
+    if pa[1] == 0.0 and pb[1] == 0.0:
+        raise ValueError(f"{label}.mirror_y: the element lies at y = 0 (point_a_m[1] = point_b_m[1] = 0), so its "
+                         "mirror image is itself and mirror_y would double it under one id; give the whole value "
+                         "without mirror_y")
+    return [el, el.mirrored_y()]
+
+
+def _check_ids(f: VehicleFileSchema, elements: list[Element]) -> None:
+    """One value and one alias per id; an element alias is not another element's id."""
+    values: dict[str, float] = {}
+    alias_of: dict[str, str] = {}
+    for e in elements:
+        if values.setdefault(e.id, e.value) != e.value:
+            raise ValueError(f"elements: id {e.id!r} given two values ({values[e.id]} and {e.value})")
+    ids = set(values)
+    for i, e in enumerate(f.elements):
+        if not e.alias:
+            continue
+        if e.alias in ids and e.alias != e.id:
+            raise ValueError(f"elements[{i}] ({e.id}).alias: {e.alias!r} is the id of another element")
+        if alias_of.setdefault(e.alias, e.id) != e.id:
+            raise ValueError(f"elements[{i}] ({e.id}).alias: {e.alias!r} already names element "
+                             f"{alias_of[e.alias]!r}")
+
+
+def _check_aliases(vehicle: Vehicle, aliases: Mapping[str, str]) -> None:
+    """An ``[aliases]`` name is new (not a parameter name) and points at a parameter."""
+    valid = vehicle.parameter_names()
+    ids = set(vehicle.element_ids())
+    for k, v in aliases.items():
+        if k in valid:
+            what = "the element id" if k in ids else "the parameter"
+            raise ValueError(f"aliases.{k}: shadows {what} {k!r} (an alias must not be a parameter name); "
+                             f"pick another name")
+        if v not in valid:
+            raise ValueError(f"aliases.{k}: unknown parameter {v!r}{did_you_mean(v, valid)}; "
+                             f"valid: {', '.join(sorted(valid))}")
+
+
+def _constraint(i: int, c: Any, names: Mapping[str, float], known: set[str]) -> ConstraintSpec:
+    label = f"constraints[{i}]"
+    for key in ("body", "to"):
+        b = getattr(c, key)
+        if (key == "body" or b) and b not in known:
+            raise ValueError(f"{label}: {key} {b!r} is not a body{did_you_mean(b, sorted(known))} "
+                             f"(bodies: {sorted(known)})")
+    return ConstraintSpec(type=c.type, body=c.body, to=c.to, dofs=tuple(c.dofs), axis=c.axis,
+                          point=_vector(c.point_m, names, f"{label}.point_m"))
+
+
+def _num(t: Any, key: str, names: Mapping[str, float], table: str, positive: bool = False,
+         lower: float | None = None, upper: float | None = None) -> float:
+    what = f"{table}.{key}"
+    raw = getattr(t, key)
+    x = math.inf if key == "wheel_transverse_radius_m" and raw == math.inf else evaluate(raw, names, what)
+    if positive and not x > 0.0:
+        raise ValueError(f"{what}: must be positive, got {x!r}")
+    if lower is not None and x < lower:
+        raise ValueError(f"{what}: must be >= {lower}, got {x!r}")
+    if upper is not None and x > upper:
+        raise ValueError(f"{what}: must be <= {upper}, got {x!r}")
     return x
 
 
-def _body(i: int, b: Mapping[str, Any], names: Mapping[str, float]) -> Body:
-    label = f"bodies[{i}] ({b.get('name', '?')})"
-    if "name" not in b:
-        raise ValueError(f"{label}: missing name")
-    mass = _number(b, "mass_kg", label)
-    if mass <= 0.0:
-        raise ValueError(f"{label}: mass_kg must be positive, got {mass!r}")
-    inertia = b.get("inertia_kg_m2")
-    if isinstance(inertia, list) and len(inertia) == 3 and all(isinstance(r, list) for r in inertia):
-        inertia = [[evaluate(x, names, f"{label}.inertia_kg_m2") for x in row] for row in inertia]  # 3x3 tensor
-        diagonal = [inertia[i][i] for i in range(3)]
-    elif isinstance(inertia, list) and len(inertia) == 3:
-        inertia = diagonal = [evaluate(x, names, f"{label}.inertia_kg_m2") for x in inertia]
-    else:
-        raise ValueError(f"{label}: inertia_kg_m2 must be [Ixx, Iyy, Izz] or a 3x3 tensor")
-    if any(x < 0.0 for x in diagonal):
-        raise ValueError(f"{label}: inertia_kg_m2 must be >= 0")
-    kind = str(b.get("kind", "body"))
-    if kind not in KINDS[:2]:
-        raise ValueError(f"{label}: kind must be 'body' or 'wheelset', got {kind!r}")
-    return Body(str(b["name"]), mass, tuple(inertia), _vector(b.get("cg_m"), names, f"{label}.cg_m"), kind,
-                str(b.get("source", "estimate")))
-
-
-def _element(i: int, e: Mapping[str, Any], names: Mapping[str, float], known: set[str]) -> tuple[Element, bool]:
-    label = f"elements[{i}] ({e.get('id', '?')})"
-    for key in ("id", "type", "body_a", "body_b"):
-        if key not in e:
-            raise ValueError(f"{label}: missing {key}")
-    etype = str(e["type"])
-    if etype not in ELEMENT_TYPES:
-        raise ValueError(f"{label}: type must be one of {sorted(ELEMENT_TYPES)}, got {etype!r}")
-    for key in ("body_a", "body_b"):
-        if e[key] != GROUND and e[key] not in known:
-            raise ValueError(f"{label}: {key} {e[key]!r} is not a body (bodies: {sorted(known)}, or 'ground')")
-    if e["body_a"] == GROUND:
-        raise ValueError(f"{label}: body_a must be a body ('ground' only as body_b)")
-    vkey = VALUE_KEYS[etype]
-    if vkey not in e:
-        raise ValueError(f"{label}: missing {vkey} (value of a {etype})")
-    value = _number(e, vkey, label)
-    if value < 0.0:
-        raise ValueError(f"{label}: {vkey} must be >= 0, got {value!r}")
-    zero = [0.0, 0.0, 0.0]
-    el = Element(id=str(e["id"]), alias=str(e.get("alias", "")), type=etype, body_a=str(e["body_a"]),
-                 point_a=_vector(e.get("point_a_m", zero), names, f"{label}.point_a_m"), body_b=str(e["body_b"]),
-                 point_b=_vector(e.get("point_b_m", zero), names, f"{label}.point_b_m"),
-                 direction=_vector(e.get("direction"), names, f"{label}.direction"), value=value,
-                 source=str(e.get("source", "estimate")))
-    return el, bool(e.get("mirror_y", False))
-
-
-def _constraint(i: int, c: Mapping[str, Any], names: Mapping[str, float], known: set[str]) -> ConstraintSpec:
-    label = f"constraints[{i}]"
-    for key in ("type", "body"):
-        if key not in c:
-            raise ValueError(f"{label}: missing {key}")
-    for key in ("body", "to"):
-        if key in c and c[key] not in known:
-            raise ValueError(f"{label}: {key} {c[key]!r} is not a body (bodies: {sorted(known)})")
-    if c["type"] in ("rigid", "hinge") and "to" not in c:
-        raise ValueError(f"{label}: missing to")
-    if c["type"] == "rigid" and not c.get("dofs"):
-        raise ValueError(f"{label}: rigid constraint needs dofs")
-    return ConstraintSpec(type=str(c["type"]), body=str(c["body"]), to=str(c.get("to", "")),
-                          dofs=tuple(c.get("dofs", ())), axis=str(c.get("axis", "y")),
-                          point=_vector(c.get("point_m", [0, 0, 0]), names, f"{label}.point_m"))
-
-
-def _contact(t: Mapping[str, Any], names: Mapping[str, float]) -> ContactSpec | None:
-    if not t:
+def _contact(t: ContactSchema | None, names: Mapping[str, float]) -> ContactSpec | None:
+    if t is None:
         return None
-    what = "contact"
-    r0 = _number(t, "wheel_radius_m", what, positive=True, names=names)
-    e0 = _number(t, "semi_gauge_m", what, positive=True, names=names)
-    if "conicity" in t:
-        lam = _number(t, "conicity", what)
-    elif "delta_r_m" in t:
+    r0 = _num(t, "wheel_radius_m", names, "contact", positive=True)
+    e0 = _num(t, "semi_gauge_m", names, "contact", positive=True)
+    if t.conicity is not None:
+        lam = _num(t, "conicity", names, "contact", lower=0.0)
+    else:
         from railopt.models.contact import equivalent_conicity
 
-        if "delta_r_y_m" not in t:
-            raise ValueError("contact: a Δr table needs delta_r_y_m (lateral positions) with delta_r_m")
-        lam = equivalent_conicity(t["delta_r_y_m"], t["delta_r_m"], _number(t, "amplitude_m", what, positive=True),
-                                  r0=r0, e0=e0)
-    else:
-        raise ValueError("contact: give conicity or a Δr table (delta_r_y_m, delta_r_m, amplitude_m)")
-    if lam < 0.0:
-        raise ValueError(f"contact.conicity must be >= 0, got {lam!r}")
-    mode = str(t.get("creep", "given"))
+        y = [evaluate(x, names, f"contact.delta_r_y_m[{i}]") for i, x in enumerate(t.delta_r_y_m)]
+        dr = [evaluate(x, names, f"contact.delta_r_m[{i}]") for i, x in enumerate(t.delta_r_m)]
+        amplitude = _num(t, "amplitude_m", names, "contact", positive=True)
+        try:
+            lam = equivalent_conicity(y, dr, amplitude, r0=r0, e0=e0)
+        except ValueError as exc:
+            field = {"y": "delta_r_y_m", "delta_r": "delta_r_m", "amplitude": "amplitude_m"}.get(
+                str(exc).split(":")[0], "delta_r_m")
+            raise ValueError(f"contact.{field}: {exc}") from None
     coeffs = None
-    if mode == "given":
-        coeffs = Creep(_number(t, "f11_N", what, positive=True), _number(t, "f22_N", what, positive=True),
-                       _number(t, "f23_N_m", what, 0.0), _number(t, "f33_N_m2", what, 0.0))
-    load = _number(t, "axle_load_N", what, positive=True) if "axle_load_N" in t else None
+    if t.creep == "given":
+        coeffs = Creep(_num(t, "f11_N", names, "contact", positive=True),
+                       _num(t, "f22_N", names, "contact", positive=True),
+                       _num(t, "f23_N_m", names, "contact"), _num(t, "f33_N_m2", names, "contact", lower=0.0))
+    load = _num(t, "axle_load_N", names, "contact", positive=True) if t.axle_load_N is not None else None
+    shear = _num(t, "shear_modulus_Pa", names, "contact", positive=True) if t.shear_modulus_Pa is not None else None
     return ContactSpec(
-        r0=r0, e0=e0, conicity=lam, theta0=_number(t, "theta0", what, 0.0), epsilon=_number(t, "epsilon", what, 0.0),
-        eta=_number(t, "eta", what, 0.0), creep=mode, coefficients=coeffs,
-        creep_factor=_number(t, "creep_factor", what, 1.0, positive=True), spin=bool(t.get("spin", True)),
-        gravity_stiffness=bool(t.get("gravity_stiffness", True)), axle_load=load,
-        youngs_modulus=_number(t, "youngs_modulus_Pa", what, 2.07e11, positive=True),
-        poisson_ratio=_number(t, "poisson_ratio", what, 0.28),
-        shear_modulus=_number(t, "shear_modulus_Pa", what, positive=True) if "shear_modulus_Pa" in t else None,
-        theory=str(t.get("theory", "kalker")),
-        rail_head_radius=_number(t, "rail_head_radius_m", what, 0.254, positive=True),
-        wheel_transverse_radius=_number(t, "wheel_transverse_radius_m", what, math.inf, positive=True),
-        source=str(t.get("source", "estimate")),
+        r0=r0, e0=e0, conicity=lam, theta0=_num(t, "theta0", names, "contact"),
+        epsilon=_num(t, "epsilon", names, "contact"), eta=_num(t, "eta", names, "contact"), creep=t.creep,
+        coefficients=coeffs, creep_factor=_num(t, "creep_factor", names, "contact", positive=True), spin=t.spin,
+        gravity_stiffness=t.gravity_stiffness, axle_load=load,
+        youngs_modulus=_num(t, "youngs_modulus_Pa", names, "contact", positive=True),
+        poisson_ratio=_num(t, "poisson_ratio", names, "contact", lower=0.0, upper=0.5),
+        shear_modulus=shear, theory=t.theory,
+        rail_head_radius=_num(t, "rail_head_radius_m", names, "contact", positive=True),
+        wheel_transverse_radius=_num(t, "wheel_transverse_radius_m", names, "contact", positive=True),
+        source=t.source,
     )
 
 
-def _track(t: Mapping[str, Any]) -> TrackSpec | None:
-    if not t:
+# what a contact error's leading name means in the file (railopt.models.contact names its arguments)
+_CONTACT_FIELDS = {
+    "a_over_b": "wheel_radius_m", "curvature_ratio": "wheel_radius_m", "R_rail": "rail_head_radius_m",
+    "R_wheel_transverse": "wheel_transverse_radius_m", "R_wheel": "wheel_transverse_radius_m",
+    "theta0": "theta0", "nu": "poisson_ratio", "E": "youngs_modulus_Pa", "G": "shear_modulus_Pa",
+}
+
+
+def _check_contact(vehicle: Vehicle) -> None:
+    """Resolve the contact (Hertz creep) and the lumped track now, so a bad value names its key at load."""
+    c = vehicle.contact
+    if c is not None:
+        try:
+            vehicle.wheel_rail()
+        except ValueError as exc:
+            lead = str(exc).split(":")[0].strip()
+            key = _CONTACT_FIELDS.get(lead)
+            if key == "wheel_radius_m":
+                raise ValueError(
+                    f"contact.wheel_radius_m: the Hertz contact of a {c.r0:g} m wheel on a {c.rail_head_radius:g} m "
+                    f"rail crown (wheel_transverse_radius_m = {c.wheel_transverse_radius:g}) is outside the creep "
+                    f"theory ({exc}); is the radius in mm? the file's unit is m") from None
+            raise ValueError(f"contact.{key}: {exc}" if key else f"contact: {exc}") from None
+    if vehicle.track is not None and c is not None:
+        try:
+            vehicle.lumped_track()
+        except ValueError as exc:
+            raise ValueError(f"track: {exc}") from None
+
+
+def _track(t: TrackSchema | None, names: Mapping[str, float]) -> TrackSpec | None:
+    if t is None:
         return None
-    what = "track"
-    return TrackSpec(track_modulus=_number(t, "track_modulus_N_m2", what, positive=True),
-                     rail_EI=_number(t, "rail_EI_N_m2", what, positive=True),
-                     mass_per_length=_number(t, "mass_per_length_kg_m", what, positive=True),
-                     damping_ratio=_number(t, "damping_ratio", what, 0.1), source=str(t.get("source", "estimate")))
+    return TrackSpec(track_modulus=_num(t, "track_modulus_N_m2", names, "track", positive=True),
+                     rail_EI=_num(t, "rail_EI_N_m2", names, "track", positive=True),
+                     mass_per_length=_num(t, "mass_per_length_kg_m", names, "track", positive=True),
+                     damping_ratio=_num(t, "damping_ratio", names, "track", lower=0.0), source=t.source)

@@ -36,7 +36,7 @@ CREEP_NAMES = ("f11", "f22", "f23", "f33")
 TRACK_NAMES = {"track_modulus": "track_modulus", "track_damping_ratio": "damping_ratio"}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Vehicle:
     """A vehicle definition (SI units); load one with :func:`railopt.models.vehicle.load_vehicle`.
 
@@ -56,6 +56,16 @@ class Vehicle:
     aliases: dict[str, str] = field(default_factory=dict)
     path: str = ""
     _cache: dict = field(default_factory=dict, compare=False, repr=False, hash=False)
+
+    def __repr__(self) -> str:
+        contact = "no contact" if self.contact is None else (
+            f"contact λ={self.contact.conicity:g} r0={self.contact.r0:g} m e0={self.contact.e0:g} m "
+            f"creep={self.contact.creep}")
+        track = "no track data" if self.track is None else "track data"
+        where = f", {self.path!r}" if self.path else ""
+        return (f"Vehicle({self.name!r}, {len(self.bodies)} bodies ({len(self.wheelsets)} wheelsets), "
+                f"{len(self.elements)} elements ({len(self.element_ids())} parameters), "
+                f"{self.total_mass:,.0f} kg, {contact}, {track}{where})")
 
     # ------------------------------------------------------------------ parameters
     def body(self, name: str) -> Body:
@@ -157,19 +167,22 @@ class Vehicle:
         raise ValueError(self._unknown(name))
 
     # ------------------------------------------------------------------ derived data
+    @property
     def total_mass(self) -> float:
         """Mass of all bodies, kg."""
         return float(sum(b.mass for b in self.bodies))
 
+    @property
     def wheelsets(self) -> tuple[Body, ...]:
+        """The bodies of kind ``"wheelset"``, in file order."""
         return tuple(b for b in self.bodies if b.kind == "wheelset")
 
     def axle_load(self) -> float:
         """W, N: the file's value or the vehicle weight shared equally by the wheelsets."""
         if self.contact is not None and self.contact.axle_load is not None:
             return self.contact.axle_load
-        n = len(self.wheelsets())
-        return GRAVITY * self.total_mass() / n if n else 0.0
+        n = len(self.wheelsets)
+        return GRAVITY * self.total_mass / n if n else 0.0
 
     def wheel_rail(self) -> WheelRail:
         """Resolved contact parameters (creep coefficients computed when ``creep = "hertz"``)."""
@@ -264,7 +277,7 @@ class Vehicle:
             in_parts=in_parts, speed=speed, output_rows=rows, aliases=self.element_aliases(),
             all_coordinates=a.coordinates, T=T, T_in=T_in,
             bodies=tuple(BodyPlace(b.name, b.kind, b.cg) for b in a.bodies),
-            wheelsets=tuple((b.name, float(b.cg[0])) for b in self.wheelsets()),
+            wheelsets=tuple((b.name, float(b.cg[0])) for b in self.wheelsets),
             semi_gauge=None if wr is None else wr.e0, block_dofs=dofs,
             groups=self.mode_groups(), main_body=self.bodies[0].name,
         )

@@ -239,7 +239,7 @@ def test_unreduced_system_with_multipliers(sd40, track: str) -> None:
         w = HZ * f
         Zz = K - w**2 * a.M + 1j * w * C
         # profile delayed at each axle: u_j = e^{−iΩτ_j} on <ws>_rail.w
-        xs = {b.name: b.cg[0] for b in sd40.wheelsets()}
+        xs = {b.name: b.cg[0] for b in sd40.wheelsets}
         lead = max(xs.values())
         u = np.zeros(len(a.inputs), dtype=complex)
         for name, x in xs.items():

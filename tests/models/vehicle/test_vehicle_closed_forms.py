@@ -49,7 +49,8 @@ def test_klingel_frequency_free_wheelset() -> None:
 def truck_file(n_axles: int, b: float, f11: float, f22: float) -> dict:
     """A rigid truck: frame plus ``n_axles`` wheelsets tied in u, v, γ; no springs; all at one height."""
     xs = np.linspace(-b, b, n_axles) if n_axles > 1 else np.zeros(1)
-    bodies = [{"name": "frame", "mass_kg": 5000.0, "inertia_kg_m2": [3000.0, 8000.0, 9000.0], "cg_m": [0, 0, 0.5]}]
+    bodies = [{"name": "frame", "kind": "body", "mass_kg": 5000.0, "inertia_kg_m2": [3000.0, 8000.0, 9000.0],
+               "cg_m": [0, 0, 0.5]}]
     constraints = []
     for i, x in enumerate(xs):
         bodies.append({"name": f"ws{i}", "kind": "wheelset", "mass_kg": 2000.0,

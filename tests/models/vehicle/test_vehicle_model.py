@@ -52,11 +52,11 @@ def test_lateral_vertical_decoupling_exact(name: str, track: str) -> None:
 
 def test_sd40_masses_add_up_to_total(sd40) -> None:
     """368,000 lb total (SPEC §2.3); about 27.8 t per axle."""
-    assert sd40.total_mass() == pytest.approx(368_000 * LB, abs=1.0)
+    assert sd40.total_mass == pytest.approx(368_000 * LB, abs=1.0)
     parts = sum(b.mass for b in sd40.bodies if b.name != "body")
     assert sd40.body("body").mass == pytest.approx(368_000 * LB - parts, abs=1.0)
     assert sd40.axle_load() / GRAVITY == pytest.approx(27_820, rel=1e-3)
-    assert len(sd40.wheelsets()) == 6 and sum(b.name.startswith("motor") for b in sd40.bodies) == 6
+    assert len(sd40.wheelsets) == 6 and sum(b.name.startswith("motor") for b in sd40.bodies) == 6
 
 
 def test_sd40_public_geometry(sd40) -> None:
@@ -143,7 +143,7 @@ def test_sd40_parameter_names(sd40) -> None:
 def test_bundled_names() -> None:
     assert set(BUNDLED) == {"sd40-2", "single-wheelset", "manchester-coach"}
     coach = load_vehicle("manchester-coach")
-    assert coach.total_mass() == pytest.approx(32_000 + 2 * 2_615 + 4 * 1_813)
+    assert coach.total_mass == pytest.approx(32_000 + 2 * 2_615 + 4 * 1_813)
     assert coach.parameter("conicity") == 0.15
 
 
