@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
@@ -145,7 +146,7 @@ class CriticalSpeed:
     frequency : float
         Hunting frequency |Im s|/2π of the critical root, Hz (nan when stable over the range).
     mode : str
-        Name of the critical mode (:func:`mode_name`, e.g. "body hunting", "bogie_front hunting"; "" if none).
+        Name of the critical mode (:func:`mode_name`, e.g. "body hunting", "front bogie hunting"; "" if none).
     eigen_solves : int
         Number of eigenvalue problems solved.
     bracket : tuple of float
@@ -313,6 +314,19 @@ def _track_body(body: str) -> bool:
     return body.endswith("_track") or body == "track"
 
 
+SIDES = ("front", "rear", "leading", "trailing", "middle", "centre", "center")
+WORDS = {"frame": "truck"}  # a locomotive's truck frame is "the truck"
+
+
+def readable(group: str) -> str:
+    """A body or group name as words: ``"frame_front"`` → "front truck", ``"bogie_rear"`` → "rear bogie",
+    ``"wheelset3"`` → "wheelset 3"; other names unchanged."""
+    parts = group.split("_")
+    if len(parts) == 2 and parts[1].lower() in SIDES:
+        return f"{parts[1]} {WORDS.get(parts[0], parts[0])}"
+    return re.sub(r"(\D)(\d+)$", r"\1 \2", group)
+
+
 def _shares(system: LinearSystem, vector: np.ndarray) -> np.ndarray:
     """Each coordinate's share of the modal kinetic energy Re(v̄_i (M v)_i) / vᴴMv (sums to 1)."""
     e = np.real(np.conj(vector) * (system.M @ vector))
@@ -355,8 +369,8 @@ def mode_name(names: Sequence[str], shares: np.ndarray, damping_ratio: float,
         elif (group != main or len(per_group) == 1) and own.get("lateral", 0.0) >= HUNTING_LATERAL * total:
             motion = "hunting"  # a truck group; or a vehicle of one body (a single wheelset)
     if not motion or motion == group:
-        return group, group, per_group[group]
-    return f"{group} {motion}", group, per_group[group]
+        return readable(group), group, per_group[group]
+    return f"{readable(group)} {motion}", group, per_group[group]
 
 
 def modes(model: LinearSystem | object, speed: float | None = None, track: str | None = None,
@@ -364,8 +378,8 @@ def modes(model: LinearSystem | object, speed: float | None = None, track: str |
     """The modes of a system (or of a model at ``speed``, m/s), one row per mode in ascending frequency.
 
     Columns: ``frequency_hz`` (|Im s|/2π), ``damping_ratio`` (−Re s/|s|), ``real`` (1/s), ``imag`` (rad/s),
-    ``name`` (:func:`mode_name`: e.g. "body lateral", "body hunting", "bogie_front hunting",
-    "wheelset3 lateral", "track"), ``group`` (the dominant body or group), ``share`` (its share of the modal
+    ``name`` (:func:`mode_name`: e.g. "body lateral", "body hunting", "front bogie hunting",
+    "wheelset 3 lateral", "track"), ``group`` (the dominant body or group), ``share`` (its share of the modal
     kinetic energy), ``track_share`` (the share of lumped track bodies).  Neutral rigid-body roots (s ≈ 0)
     are named "rigid body".  ``groups`` (body → group) default to the model's own ``groups`` (a vehicle
     view has them: each truck frame with its wheelsets and motors; the car body is its first body).

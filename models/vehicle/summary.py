@@ -5,32 +5,28 @@ render it for the command line.  :func:`main_vehicle` is the whole ``railopt veh
 command (argument list in, ``(text, exit code)`` out) and :func:`main_validate_vehicle` the vehicle
 part of ``railopt validate car.toml``, so the CLI wires each in a few lines.
 
-Modes are the roots of the lateral view at the given speed (one eigen-solve), one row per conjugate
-pair (and per real root), named by the body and coordinate holding the largest share of the mode's
-kinetic energy ``Re(x̄_j (M x)_j)``: ``"body lateral"``, ``"body yaw"``, ``"front truck yaw"``,
-``"wheelset 3 lateral"``, ``"track"``; among the oscillatory modes held mostly by trucks and
-wheelsets (> 50 % of the energy) the least damped one is the kinematic mode, ``"front truck hunting"``.
+Modes are the roots of the lateral view at the given speed (one eigen-solve), one row per mode, named by
+:func:`railopt.models.stability.modes` from the shares of the modal kinetic energy by body group
+(``"body lateral"``, ``"body hunting"``, ``"front truck hunting"``, ``"wheelset 3 lateral"``, ``"track"``);
+the critical speeds name their critical mode the same way.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
+from railopt.models.stability import modes
 from railopt.models.units import GRAVITY
-from railopt.models.vehicle.elements import GROUND
-from railopt.models.vehicle.plausibility import NOMINAL_SPEED, PlausibilityWarning, plausibility, sprung_bodies
+from railopt.models.vehicle.plausibility import NOMINAL_SPEED, PlausibilityWarning, plausibility
 from railopt.models.vehicle.vehicle import Vehicle
 
 SPEED_RANGE = (1.0, 150.0)  # m/s, searched for the critical speeds
 TOL = 0.01  # m/s
-DOF_NAMES = {"u": "longitudinal", "v": "lateral", "w": "bounce", "alpha": "roll", "beta": "pitch", "gamma": "yaw"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,7 +99,7 @@ class VehicleSummary:
                 note = " (unstable at the lower end)" if c.unstable_at_lower_end else ""
                 crit.append((track, f"{c.speed:.2f} m/s ({c.speed * 3.6:.1f} km/h){note}",
                              f"{c.frequency:.3f} Hz", c.mode))
-        out += _table(["track", "critical speed", "frequency", "largest coordinate"], crit, markdown) + [""]
+        out += _table(["track", "critical speed", "frequency", "critical mode"], crit, markdown) + [""]
         out += [f"{h}Lateral modes at {self.speed:g} m/s, {self.track} track", ""]
         rows = [(f"{r.frequency_hz:.3f}", f"{r.damping_ratio:.3f}", f"{r.real:.3f}", r.name, f"{r.share:.2f}")
                 for r in self.modes.itertuples()]
@@ -131,107 +127,12 @@ def _table(head: Sequence[str], rows: Sequence[Sequence[str]], markdown: bool) -
     return [fmt.format(*head), fmt.format(*("-" * w for w in widths))] + [fmt.format(*r) for r in rows]
 
 
-def _readable(name: str) -> str:
-    return re.sub(r"(\D)(\d+)$", r"\1 \2", name)
-
-
-def _truck(v: Vehicle, name: str) -> str:
-    """``"front truck"`` / ``"rear bogie"`` for a body carrying wheelsets."""
-    word = "bogie" if "bogie" in name.lower() else "truck"
-    low = name.lower()
-    side = "front" if "front" in low else "rear" if "rear" in low else ("front" if v.body(name).cg[0] > 0 else "rear")
-    return f"{side} {word}"
-
-
-def kinematic_band(vehicle: Vehicle, speed: float) -> tuple[float, float]:
-    """Frequencies (Hz) where a hunting mode lies at ``speed``: half the truck's and twice the wheelset's kinematic
-    frequency ``S/2π · sqrt(λ/(e0 r0))`` (the truck's divided by ``sqrt(1 + b²/e0²)``, b its largest half
-    wheelbase); ``(0, 0)`` without contact."""
-    c = vehicle.contact
-    if c is None or c.conicity <= 0.0 or not vehicle.wheelsets:
-        return 0.0, 0.0
-    f_ws = speed / (2.0 * math.pi) * math.sqrt(c.conicity / (c.e0 * c.r0))
-    b = 0.0
-    for carrier in _carriers(vehicle):
-        x0 = vehicle.body(carrier).cg[0]
-        mine = [w.cg[0] - x0 for w in vehicle.wheelsets if carrier in _links_of(vehicle, w.name)]
-        b = max([b] + [abs(x) for x in mine])
-    return 0.5 * f_ws / math.sqrt(1.0 + (b / c.e0) ** 2), 2.0 * f_ws
-
-
-def _links_of(v: Vehicle, name: str) -> set[str]:
-    out = {e.body_b for e in v.elements if e.body_a == name} | {e.body_a for e in v.elements if e.body_b == name}
-    out |= {c.to for c in v.constraints if c.body == name and c.to} | {c.body for c in v.constraints if c.to == name}
-    return out - {GROUND}
-
-
-def _carriers(v: Vehicle) -> set[str]:
-    """Bodies of kind "body" linked to a wheelset (truck frames, bogies, motors)."""
-    wheelsets = {b.name for b in v.wheelsets}
-    return {b for w in wheelsets for b in _links_of(v, w)} - wheelsets
-
-
-HUNTING_YAW_SHARE = 0.01  # share of the kinetic energy in truck / wheelset yaw of a hunting mode
-
-
 def mode_table(vehicle: Vehicle, speed: float, track: str = "rigid") -> pd.DataFrame:
     """Lateral modes at ``speed`` (m/s) on ``track``: ``frequency_hz``, ``damping_ratio``, ``real``, ``name``,
-    ``share``, one row per conjugate pair or real root, ascending frequency.
-
-    A mode is named by the body and coordinate holding the largest share of its kinetic energy
-    ``Re(x̄_j (M x)_j)`` (``"body lateral"``, ``"front truck yaw"``, ``"wheelset 3 lateral"``, ``"track"``;
-    ``"wheelsets yaw"`` when the wheelsets hold most of it but none alone half).  The hunting mode is the least
-    damped oscillatory mode inside :func:`kinematic_band` with at least 1 % of its energy in truck and wheelset yaw,
-    named after the truck (or wheelset) holding most energy: ``"front truck hunting"``.
-    """
-    view = vehicle.lateral(track, speed=speed)
-    m = view.at().modal()
-    n = view.n_dof
-    X = m.V[:n, :]
-    energy = np.real(X.conj() * (view.M @ X))  # (n, 2n): per-coordinate parts of x̄ᵀ M x
-    total = energy.sum(axis=0)
-    bodies = [c.rsplit(".", 1)[0] for c in view.coordinates]
-    dofs = [c.rsplit(".", 1)[1] for c in view.coordinates]
-    sprung = set(sprung_bodies(vehicle))
-    wheelsets = {b.name for b in vehicle.wheelsets}
-    carriers = _carriers(vehicle) - sprung
-    running = carriers | wheelsets
-    yaw = np.array([b in running and d == "gamma" for b, d in zip(bodies, dofs, strict=True)])
-    band = kinematic_band(vehicle, speed)
-    rows = []
-    for k, s in enumerate(m.s):
-        if s.imag < 0.0:
-            continue
-        share = energy[:, k] / total[k] if total[k] > 0 else np.zeros(n)
-        by_body: dict[str, float] = {}
-        for b, e in zip(bodies, share, strict=True):
-            by_body[b] = by_body.get(b, 0.0) + e
-        body = max(by_body, key=by_body.get)
-        idx = [i for i in range(n) if bodies[i] == body]
-        dof = DOF_NAMES[dofs[max(idx, key=lambda i: share[i])]]
-        ws_share = sum(e for b, e in by_body.items() if b in wheelsets)
-        if body.endswith("_track") and body not in {b.name for b in vehicle.bodies}:
-            name = "track"
-        elif ws_share > 0.5 and by_body[body] < 0.5:
-            name = f"wheelsets {dof}"
-        elif body in wheelsets or body in sprung or body not in carriers:
-            name = f"{_readable(body)} {dof}"
-        else:
-            name = f"{_truck(vehicle, body)} {dof}"
-        mag = abs(s)
-        f = abs(s.imag) / (2.0 * math.pi)
-        gear = [b for b in by_body if b in running]
-        lead = max(gear, key=by_body.get) if gear else ""
-        hunting = f > 0.0 and band[0] <= f <= band[1] and float(share[yaw].sum()) >= HUNTING_YAW_SHARE and lead
-        rows.append({"frequency_hz": f, "damping_ratio": -s.real / mag if mag else 1.0, "real": float(s.real),
-                     "name": name, "share": float(by_body[body]), "_hunting": bool(hunting), "_lead": lead})
-    df = pd.DataFrame(rows).sort_values(["frequency_hz", "real"], kind="stable").reset_index(drop=True)
-    candidates = df[df["_hunting"]]
-    if len(candidates):
-        j = candidates["damping_ratio"].idxmin()
-        lead = df.at[j, "_lead"]
-        df.at[j, "name"] = f"{_truck(vehicle, lead) if lead in carriers else _readable(lead)} hunting"
-    return df.drop(columns=["_hunting", "_lead"])
+    ``share``, one row per mode in ascending frequency, named by :func:`railopt.models.stability.modes`
+    (kinetic-energy shares by body group: "body lateral", "body hunting", "front truck hunting", "track")."""
+    table = modes(vehicle.lateral(track, speed=speed))
+    return table[["frequency_hz", "damping_ratio", "real", "name", "share"]]
 
 
 def vehicle_summary(vehicle: Vehicle, speed: float | None = None, track: str = "rigid") -> VehicleSummary:
