@@ -268,8 +268,7 @@ def report(result: ForcedResult, writer: Writer) -> str:
     writer.table(result.table, "peaks")
     if not result.modes.empty:
         writer.table(result.modes, "modes")
-    figures = [(f.group, f.panel, f.band, f"{f.name}.png") for f in result.figures]
-    return _summary(cfg, result.table, result.modes, result.frf, figures, result.checks, result.tracks)
+    return "\n".join(line for section in SECTIONS for line in section(result)) + "\n"
 
 
 def _modes(group: str, label: str, model, sys, min_hz: float) -> list[dict]:
@@ -357,12 +356,10 @@ def _findings(table: pd.DataFrame) -> list[str]:
     return lines
 
 
-def _summary(cfg: ForcedResponseConfig, table: pd.DataFrame, modes: pd.DataFrame, frf: pd.DataFrame,
-             figures: list, checks: list[str], tracks: list) -> str:
-    lines = [f"# {cfg.study.name}", "", cfg.study.description, ""]
-    refs = {m.label: m.validated_options("models") for m in cfg.models}
-    lines += ["## Models", ""]
-    for label, o in refs.items():
+def _models_section(r: ForcedResult) -> list[str]:
+    cfg = r.config
+    lines = [f"# {cfg.study.name}", "", cfg.study.description, "", "## Models", ""]
+    for label, o in ((m.label, m.validated_options("models")) for m in cfg.models):
         lines.append(f"* `{label}`: {o.vehicle}, {o.view} block, {o.track} track, S = {o.speed_m_s:g} m/s "
                      f"({o.speed_m_s / MPH:.1f} mph), {o.input.kind} irregularity, amplitude "
                      f"{o.input.amplitude_m:g} m per rail ({o.input.amplitude_m / INCH:.3g} in)")
@@ -371,50 +368,78 @@ def _summary(cfg: ForcedResponseConfig, table: pd.DataFrame, modes: pd.DataFrame
             lines.append(f"* group `{g.label}`: the thesis's sweep — fixed wavelength L = {g.wavelength_m:g} m "
                          f"({g.wavelength_m / FOOT:.3g} ft), each frequency f run at S = f L (the models' speeds "
                          "unused)")
-    lines += ["", "A frequency f at speed S is the wavelength L = S/f; each axle sees the profile delayed by its "
-              "distance behind the leading axle over S.  Amplitudes are the responses to the irregularity "
-              "amplitude above (m, rad, m/s²); our signs (the thesis's pitch is −β: phases differ by 180°, "
-              "amplitudes do not).", ""]
-    lines += ["## Rigid vs flexible track", ""] + _findings(table) + [""]
-    if cfg.notes:
-        lines += [cfg.notes.strip(), ""]
-    lines += ["## Peaks (band maxima) and the flexible/rigid ratio", "",
-              markdown_table(table, digits=4), ""]
-    for group, lt in tracks:
-        f0 = np.sqrt(lt.K_e_pair / lt.m_e_pair) / HZ
-        line = (f"Lumped track ({group} models): K_e = {lt.K_e_pair:.4g} N/m, m_e = {lt.m_e_pair:.4g} kg, "
-                f"C_e = {lt.C_e_pair:.4g} N·s/m per rail pair; its own frequency f0 = √(K_e/m_e)/2π = {f0:.2f} Hz "
-                "(4.35).")
-        if not modes.empty:
-            own = modes[(modes["group"] == group) & modes["dominant"].str.split(",").str[0].str.contains("_track")]
-            if not own.empty:
-                f_lo, f_hi = own["frequency_hz"].min(), own["frequency_hz"].max()
-                z_lo, z_hi = own["damping_ratio"].min(), own["damping_ratio"].max()
-                line += ("  Coupled to the vehicle the wheelset rides on m_e (4.66), so the track's own modes are "
-                         f"those of the track carrying the wheelset, at {f_lo:.2f}–{f_hi:.2f} Hz (ζ {z_lo:.3f}–"
-                         f"{z_hi:.3f}); nothing resonates at f0.")
-        lines += [line, ""]
+    return lines + ["", "A frequency f at speed S is the wavelength L = S/f; each axle sees the profile delayed by "
+                    "its distance behind the leading axle over S.  Amplitudes are the responses to the irregularity "
+                    "amplitude above (m, rad, m/s²); our signs (the thesis's pitch is −β: phases differ by 180°, "
+                    "amplitudes do not).", ""]
+
+
+def _findings_section(r: ForcedResult) -> list[str]:
+    lines = ["## Rigid vs flexible track", ""] + _findings(r.table) + [""]
+    return lines + ([r.config.notes.strip(), ""] if r.config.notes else [])
+
+
+def _lumped_track_line(group: str, lt, modes: pd.DataFrame) -> str:
+    f0 = np.sqrt(lt.K_e_pair / lt.m_e_pair) / HZ
+    line = (f"Lumped track ({group} models): K_e = {lt.K_e_pair:.4g} N/m, m_e = {lt.m_e_pair:.4g} kg, "
+            f"C_e = {lt.C_e_pair:.4g} N·s/m per rail pair; its own frequency f0 = √(K_e/m_e)/2π = {f0:.2f} Hz "
+            "(4.35).")
     if not modes.empty:
-        lines += [f"## Modes of the flexible-track models above {cfg.track_mode_min_hz:g} Hz", "",
-                  markdown_table(modes, digits=5), ""]
+        own = modes[(modes["group"] == group) & modes["dominant"].str.split(",").str[0].str.contains("_track")]
+        if not own.empty:
+            f_lo, f_hi = own["frequency_hz"].min(), own["frequency_hz"].max()
+            z_lo, z_hi = own["damping_ratio"].min(), own["damping_ratio"].max()
+            line += ("  Coupled to the vehicle the wheelset rides on m_e (4.66), so the track's own modes are "
+                     f"those of the track carrying the wheelset, at {f_lo:.2f}–{f_hi:.2f} Hz (ζ {z_lo:.3f}–"
+                     f"{z_hi:.3f}); nothing resonates at f0.")
+    return line
+
+
+def _peaks_section(r: ForcedResult) -> list[str]:
+    lines = ["## Peaks (band maxima) and the flexible/rigid ratio", "", markdown_table(r.table, digits=4), ""]
+    for group, lt in r.tracks:
+        lines += [_lumped_track_line(group, lt, r.modes), ""]
+    return lines
+
+
+def _modes_section(r: ForcedResult) -> list[str]:
+    if r.modes.empty:
+        return []
+    return [f"## Modes of the flexible-track models above {r.config.track_mode_min_hz:g} Hz", "",
+            markdown_table(r.modes, digits=5), ""]
+
+
+def _low_frequency_section(r: ForcedResult) -> list[str]:
+    frf = r.frf
     low = frf[frf["frequency_hz"] == frf.groupby(["group", "band"])["frequency_hz"].transform("min")]
     low = low.drop_duplicates(["group", "output"])
-    lines += ["## Low-frequency limit (lowest grid frequency)", "",
-              markdown_table(low[["group", "output", "frequency_hz", "wavelength_m", "rigid_amplitude",
-                                  "flexible_amplitude"]], digits=6), ""]
-    lines += ["## Checks", ""]
-    if checks:
-        lines += [f"* {c}" for c in checks]
+    return ["## Low-frequency limit (lowest grid frequency)", "",
+            markdown_table(low[["group", "output", "frequency_hz", "wavelength_m", "rigid_amplitude",
+                                "flexible_amplitude"]], digits=6), ""]
+
+
+def _checks_section(r: ForcedResult) -> list[str]:
+    lines = ["## Checks", ""]
+    if r.checks:
+        lines += [f"* {c}" for c in r.checks]
     else:
         lines.append("* every model stable at its speed; residual of Z X = F ≤ 1e-10 relative at every frequency "
                      "computed")
-    for group, t in table.groupby("group", sort=False):
+    for group, t in r.table.groupby("group", sort=False):
         how = ("certified exact band maxima" if bool(t["certified"].all())
                else "grid maxima refined by Brent (fixed wavelength: one system per speed, not certified)")
         lines.append(f"* {group}: peaks are {how}")
-    lines += ["", "## Figures", ""]
-    lines += [f"* {p.figure} {p.title} ({b}): ![{name}]({name})" for _, p, b, name in figures]
-    return "\n".join(lines) + "\n"
+    return lines
+
+
+def _figures_section(r: ForcedResult) -> list[str]:
+    return ["", "## Figures", ""] + [f"* {f.panel.figure} {f.panel.title} ({f.band}): ![{f.name}.png]({f.name}.png)"
+                                     for f in r.figures]
+
+
+SECTIONS = [_models_section, _findings_section, _peaks_section, _modes_section, _low_frequency_section,
+            _checks_section, _figures_section]
+"""The summary, section by section."""
 
 
 KIND = register_kind(StudyKind(
