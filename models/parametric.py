@@ -323,17 +323,23 @@ class ParametricSystem:
         return dF
 
     # ------------------------------------------------------------------ thin delegates
-    def response_maxima(self, p: Sequence[float], band: tuple[float, float], exact: bool = False,
+    def response_maxima(self, p: Sequence[float], band: object = None, *, band_hz: tuple[float, float] | None = None,
+                        band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                         output: str | None = None, speed: float | None = None):
-        """f_k(p) of (4.71)-(4.73) over ``band`` (rad/s); see :func:`railopt.models.response_maxima.response_maxima`."""
-        return self.at(p, speed).response_maxima(band, exact=exact, output=output)
+        """f_k(p) of (4.71)-(4.73) over ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s);
+        see :func:`railopt.models.response_maxima.response_maxima`."""
+        return self.at(p, speed).response_maxima(band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact,
+                                                 output=output)
 
-    def response_maxima_jacobian(self, p: Sequence[float], band: tuple[float, float], exact: bool = False,
+    def response_maxima_jacobian(self, p: Sequence[float], band: object = None, *,
+                                 band_hz: tuple[float, float] | None = None,
+                                 band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                                  output: str | None = None, speed: float | None = None):
         """f_k(p) and df_k/dp (n+2, P); see :func:`railopt.models.sensitivity.response_maxima_jacobian`."""
         from railopt.models.sensitivity import response_maxima_jacobian
 
-        return response_maxima_jacobian(self.at(p, speed), band, exact=exact, output=output)
+        return response_maxima_jacobian(self.at(p, speed), band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact,
+                                        output=output)
 
     def damped_frequency_jacobian(self, p: Sequence[float], speed: float | None = None) -> np.ndarray:
         """dω_dj/dp (n, P); see :func:`railopt.models.sensitivity.damped_frequency_jacobian`."""

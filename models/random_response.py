@@ -225,7 +225,7 @@ def random_response(system: LinearSystem, spectrum: object, speed_m_s: float, ba
 
     def integrand(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         flat = nodes.ravel()
-        h = system.frf_outputs(flat)[:, col]
+        h = system.frf_outputs(omega_rad_s=flat)[:, col]
         g2 = (h.real**2 + h.imag**2).reshape(nodes.shape)
         if not np.all(np.isfinite(g2)):
             raise ValueError(f"system: |H| is infinite in the band (an undamped resonance); output {name!r}")
@@ -289,7 +289,7 @@ def output_psd(system: LinearSystem, spectrum: object, speed_m_s: float, frequen
     if f.size == 0 or not np.all(np.isfinite(f)) or np.any(f <= 0):
         raise ValueError("frequencies_hz: must be a non-empty array of finite frequencies > 0 Hz")
     _check_spectrum_band(spectrum, V, (float(np.min(f)), float(np.max(f))))
-    h = system.frf(TWO_PI * f.ravel(), _output_name(system, output))
+    h = system.frf(omega_rad_s=TWO_PI * f.ravel(), output=_output_name(system, output))
     return (np.abs(h) ** 2 * TWO_PI * _input_psd(spectrum, TWO_PI * f.ravel(), V)).reshape(f.shape)
 
 

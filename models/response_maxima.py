@@ -34,6 +34,7 @@ import pandas as pd
 from railopt.models.modal import NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots
 from railopt.models.peak_search import cell_maxima
 from railopt.models.validation import band as validate_band
+from railopt.models.validation import band_arg
 from railopt.records import ArrayRecord
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -141,7 +142,8 @@ class ResponseMaxima(ArrayRecord):
         )
 
 
-def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool = False,
+def response_maxima(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
+                    band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                     output: str | None = None) -> ResponseMaxima:
     """Response maxima f_k (4.71)-(4.73) of one output of ``system`` over ``band`` (rad/s).
 
@@ -149,19 +151,23 @@ def response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool
     optimiser can carry on.
     """
     name = system.output_names[system.output_index(output)]
-    return all_response_maxima(system, band, exact=exact, outputs=[name])[name]
+    band_rad_s = band_arg(band, band_hz, band_rad_s)
+    return all_response_maxima(system, band_rad_s=band_rad_s, exact=exact, outputs=[name])[name]
 
 
-def peak(system: LinearSystem, band: tuple[float, float], exact: bool = True, output: str | None = None) -> float:
-    """``U = max_k f_k`` (4.74) of one output over ``band`` (rad/s); ``exact=True`` gives the certified
-    band maximum."""
-    return response_maxima(system, band, exact=exact, output=output).value
+def peak(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
+         band_rad_s: tuple[float, float] | None = None, exact: bool = True, output: str | None = None) -> float:
+    """``U = max_k f_k`` (4.74) of one output over ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s); ``exact=True``
+    gives the certified band maximum."""
+    return response_maxima(system, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, output=output).value
 
 
-def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: bool = False,
+def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
+                        band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                         outputs: list[str] | None = None) -> dict[str, ResponseMaxima]:
-    """f_k of several outputs sharing one eigen-decomposition and one frequency grid."""
-    lo, hi = validate_band(band)
+    """f_k of several outputs sharing one eigen-decomposition and one frequency grid; the band as
+    ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s), see :func:`railopt.models.validation.band_arg`."""
+    lo, hi = band_arg(band, band_hz, band_rad_s)
     names = list(system.output_names if outputs is None else outputs)
     cols = [system.output_index(nm) for nm in names]
     if exact:
@@ -185,7 +191,7 @@ def all_response_maxima(system: LinearSystem, band: tuple[float, float], exact: 
     resonant = system.undamped_modes() & (wd >= lo) & (wd <= hi)
     if not exact:
         freqs = np.concatenate([clipped, edges])
-        H = _finite_or_inf(np.abs(system.frf_outputs(np.concatenate([clipped_eval, edges_eval]))))
+        H = _finite_or_inf(np.abs(system.frf_outputs(omega_rad_s=np.concatenate([clipped_eval, edges_eval]))))
         if lo_eval > lo:  # the limit Ω → 0 at the lower edge (and at modes clipped to it)
             H[np.concatenate([clipped_eval, edges_eval]) == lo_eval] = at_zero
         out = {}
@@ -252,7 +258,7 @@ def _zero_limit(system: LinearSystem, names: list[str], cols: list[int], hi: flo
     if scale == 0.0 or not np.any(neutral):
         return 0.0, None
     eps = min(ZERO_STEP * float(np.min(np.abs(s[~neutral]))), 1e-3 * hi)
-    H = system.frf_outputs(np.array([eps, 2 * eps, 0.1 * eps]))
+    H = system.frf_outputs(omega_rad_s=np.array([eps, 2 * eps, 0.1 * eps]))
     mags = np.abs(H)[:, cols]
     growing = ~np.isfinite(mags[2]) | (mags[2] > 1.5 * mags[0] + 1e-300)
     if np.any(growing):
@@ -266,7 +272,7 @@ def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
                  edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool, np.ndarray] | None:
     """Cell maxima (values by direct solves at the refined frequencies) for each output column, and |H| at
     the band edges (the same batch of direct solves)."""
-    sample = system.frf_outputs if pr is None else pr.evaluate
+    sample = (lambda w: system.frf_outputs(omega_rad_s=w)) if pr is None else pr.evaluate
     mags = _finite_or_inf(np.abs(sample(grid)))
     xs, fs = [], []
     for c in cols:
@@ -276,7 +282,7 @@ def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
         xs.append(x)
         fs.append(f)
     X = np.array(xs)
-    direct = _finite_or_inf(np.abs(system.frf_outputs(np.concatenate([X.ravel(), edges]))))
+    direct = _finite_or_inf(np.abs(system.frf_outputs(omega_rad_s=np.concatenate([X.ravel(), edges]))))
     edge_vals, direct = direct[-len(edges):], direct[: -len(edges)]
     F = np.array([direct[i * X.shape[1]:(i + 1) * X.shape[1], c] for i, c in enumerate(cols)])
     if pr is not None:

@@ -24,7 +24,7 @@ import numpy as np
 from railopt.models.modal import mode_order
 from railopt.models.response_maxima import ResponseMaxima, all_response_maxima
 from railopt.models.system import LinearSystem, Tangent
-from railopt.models.validation import band as validate_band
+from railopt.models.validation import band_arg
 
 
 def _tangent(system: LinearSystem) -> Tangent:
@@ -86,15 +86,16 @@ def _partials(system: LinearSystem, omega: float, cols: list[int]) -> tuple[np.n
     return H, dH, dHw
 
 
-def maxima_jacobians(system: LinearSystem, band: tuple[float, float], exact: bool = False,
+def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
+                     band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                      outputs: Sequence[str] | None = None) -> dict[str, tuple[ResponseMaxima, np.ndarray]]:
     """f_k and their analytic Jacobians ``df_k/dp_i`` (n+2, P) for several outputs of a family member,
-    sharing its eigen-decomposition.  ``band`` in rad/s.  Entries with f_k = inf (zero damping,
-    singular Z) get a zero gradient row."""
+    sharing its eigen-decomposition.  The band as ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s).  Entries with
+    f_k = inf (zero damping, singular Z, no steady state) get a zero gradient row."""
     t = _tangent(system)
-    lo, hi = validate_band(band)
+    lo, hi = band_arg(band, band_hz, band_rad_s)
     names = list(system.output_names if outputs is None else outputs)
-    maxima = all_response_maxima(system, (lo, hi), exact=exact, outputs=names)
+    maxima = all_response_maxima(system, band_rad_s=(lo, hi), exact=exact, outputs=names)
     n, P = system.n, len(t.parameters)
     dwd = damped_frequency_jacobian(system)
     wd = system.damped_frequencies()
@@ -126,11 +127,12 @@ def maxima_jacobians(system: LinearSystem, band: tuple[float, float], exact: boo
     return result
 
 
-def response_maxima_jacobian(system: LinearSystem, band: tuple[float, float], exact: bool = False,
-                             output: str | None = None) -> tuple[ResponseMaxima, np.ndarray]:
+def response_maxima_jacobian(system: LinearSystem, band: object = None, *,
+                             band_hz: tuple[float, float] | None = None, band_rad_s: tuple[float, float] | None = None,
+                             exact: bool = False, output: str | None = None) -> tuple[ResponseMaxima, np.ndarray]:
     """f_k of one output of a family member and its analytic Jacobian ``df_k/dp_i``, shape (n+2, P)."""
     name = system.output_names[system.output_index(output)]
-    return maxima_jacobians(system, band, exact=exact, outputs=[name])[name]
+    return maxima_jacobians(system, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, outputs=[name])[name]
 
 
 def root_jacobian(system: LinearSystem) -> np.ndarray:

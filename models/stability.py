@@ -24,7 +24,12 @@ import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
 from railopt.models.modal import NEUTRAL_ROOT, mode_order
-from railopt.models.sensitivity import damping_ratio_jacobian, root_jacobian, root_speed_derivative
+from railopt.models.sensitivity import (
+    damping_ratio_jacobian,
+    eigenvalue_derivatives,
+    root_jacobian,
+    root_speed_derivative,
+)
 from railopt.models.system import LinearSystem
 from railopt.models.validation import number
 from railopt.records import ArrayRecord
@@ -429,19 +434,29 @@ def _family_rows(family, p, speeds: Sequence[float], exclude: Sequence[str]):
         yield float(S), system, idx, keep
 
 
+def _wrt_jacobian(system: LinearSystem, wrt: Sequence[int] | None) -> np.ndarray:
+    """ds/dp (2n, len(wrt)) for the parameters at indices ``wrt`` (all when None)."""
+    if wrt is None:
+        return root_jacobian(system)
+    t = system.tangent
+    idx = list(wrt)
+    return eigenvalue_derivatives(system, t.dM[idx], t.dC[idx], t.dK[idx])
+
+
 def root_constraints(family, p: Sequence[float] | None, speeds: Sequence[float], sigma_min: float = 0.0,
-                     exclude: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
+                     exclude: Sequence[str] = (), wrt: Sequence[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Stability constraint rows ``g = Re s_j(p, S_k) + σ_min ≤ 0`` for every mode j at every speed S_k (SPEC §2.5).
 
     One row per mode (n per speed, mode order), so the count is fixed as the design changes; a neutral root,
     a track mode (lumped track bodies carry most of its energy) or a mode named in ``exclude`` (a name, a body
     or a name prefix) gets the constant row −1 with a zero gradient.  Returns ``(g (K·n,), dg/dp (K·n, P))``,
-    1/s.  ``family`` is a ParametricSystem with a speed term; ``p`` its parameters (None: its values).
+    1/s.  ``family`` is a ParametricSystem with a speed term; ``p`` its parameters (None: its values);
+    ``wrt`` the indices of the parameters to differentiate (default all; the Jacobian has one column each).
     """
     sigma_min = number("sigma_min", sigma_min, non_negative=True)
     values, jac = [], []
     for _, system, idx, keep in _family_rows(family, p, speeds, exclude):
-        ds = root_jacobian(system)[idx]
+        ds = _wrt_jacobian(system, wrt)[idx]
         s = system.modal().s[idx]
         values.append(np.where(keep, s.real + sigma_min, -1.0))
         jac.append(np.where(keep[:, None], ds.real, 0.0))
@@ -449,7 +464,7 @@ def root_constraints(family, p: Sequence[float] | None, speeds: Sequence[float],
 
 
 def damping_constraints(family, p: Sequence[float] | None, speeds: Sequence[float], zeta_min: float,
-                        exclude: Sequence[str] = ()) -> tuple[np.ndarray, np.ndarray]:
+                        exclude: Sequence[str] = (), wrt: Sequence[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Rows ``g = ζ_min − ζ_j(p, S_k) ≤ 0``: every vehicle mode at least ``ζ_min`` damped at every speed (SPEC §2.5).
 
     Conventions as :func:`root_constraints` (excluded rows −1); ζ = −Re s/|s| with
@@ -459,7 +474,7 @@ def damping_constraints(family, p: Sequence[float] | None, speeds: Sequence[floa
     values, jac = [], []
     for _, system, idx, keep in _family_rows(family, p, speeds, exclude):
         s = system.modal().s[idx]
-        dzeta = damping_ratio_jacobian(s, root_jacobian(system)[idx])
+        dzeta = damping_ratio_jacobian(s, _wrt_jacobian(system, wrt)[idx])
         values.append(np.where(keep, zeta_min + s.real / np.abs(s), -1.0))
         jac.append(np.where(keep[:, None], -dzeta, 0.0))
     return np.concatenate(values), np.vstack(jac)

@@ -22,7 +22,7 @@ import scipy.linalg as sla
 from railopt.models.forcing import Forcing, ForcingLike, as_forcing
 from railopt.models.modal import CONDITION_LIMIT, UNDAMPED_ROOT, Modal, modal, mode_order
 from railopt.models.pole_residue import PoleResidue
-from railopt.models.validation import frequencies_rad_s, real_array, square_matrix
+from railopt.models.validation import frequencies_arg, real_array, square_matrix
 
 if TYPE_CHECKING:  # pragma: no cover
     from railopt.models.response_maxima import ResponseMaxima
@@ -282,14 +282,16 @@ class LinearSystem:
                 X[i] = sla.lu_solve(lu, F[i], check_finite=False)
         return X
 
-    def frf_outputs(self, omega: float | np.ndarray) -> np.ndarray:
-        """Complex FRF of every output by direct solves, shape (N, m) (eqs. 4.69-4.70).
+    def frf_outputs(self, omega: object = None, *, frequencies_hz: object = None,
+                    omega_rad_s: object = None) -> np.ndarray:
+        """Complex FRF of every output by direct solves, shape (N, m) (eqs. 4.69-4.70), at ``frequencies_hz=``
+        (Hz) or ``omega_rad_s=`` (rad/s) (:func:`~railopt.models.validation.frequencies_arg`).
 
         ``H_o(Ω) = (iΩ)^q_o c_o·Z(Ω)⁻¹F(Ω)``; a singular Z (an undamped resonance hit exactly)
         gives ``inf``.
         """
         self._out(None)  # a system without outputs has no response
-        w = frequencies_rad_s(omega)
+        w = frequencies_arg(omega, frequencies_hz, omega_rad_s)
         F = np.array([self.forcing_at(float(x)) for x in w], dtype=complex).reshape(len(w), self.n)
         with np.errstate(over="ignore", invalid="ignore"):
             Z = (self.K[None] - w[:, None, None] ** 2 * self.M[None]) + 1j * w[:, None, None] * self.C[None]
@@ -326,30 +328,37 @@ class LinearSystem:
         self._out(output)
         return 0 if output is None else list(self.outputs).index(output)
 
-    def frf(self, omega: float | np.ndarray, output: str | None = None) -> complex | np.ndarray:
-        """Complex frequency response of one output at Ω (rad/s), scalar or array (direct solves)."""
-        w = np.asarray(frequencies_rad_s(omega)).reshape(np.shape(omega))
-        h = self.frf_outputs(w.ravel())[:, self.output_index(output)]
-        return complex(h[0]) if w.ndim == 0 else h.reshape(w.shape)
+    def frf(self, omega: object = None, output: str | None = None, *, frequencies_hz: object = None,
+            omega_rad_s: object = None) -> complex | np.ndarray:
+        """Complex frequency response of one output at ``frequencies_hz=`` (Hz) or ``omega_rad_s=`` (rad/s),
+        scalar or array (direct solves)."""
+        shape = np.shape(frequencies_hz if frequencies_hz is not None else omega_rad_s)
+        w = frequencies_arg(omega, frequencies_hz, omega_rad_s)
+        h = self.frf_outputs(omega_rad_s=w)[:, self.output_index(output)]
+        return complex(h[0]) if len(shape) == 0 else h.reshape(shape)
 
-    def magnitude(self, omega: float | np.ndarray, output: str | None = None) -> float | np.ndarray:
+    def magnitude(self, omega: object = None, output: str | None = None, *, frequencies_hz: object = None,
+                  omega_rad_s: object = None) -> float | np.ndarray:
         """``f(Ω) = |H(Ω)|``: the real-valued transfer function of (4.71)."""
-        return np.abs(self.frf(omega, output))
+        return np.abs(self.frf(omega, output, frequencies_hz=frequencies_hz, omega_rad_s=omega_rad_s))
 
     # ------------------------------------------------------------------ thin delegates (railopt.models.response_maxima)
-    def response_maxima(self, band: tuple[float, float], exact: bool = False,
+    def response_maxima(self, band: object = None, *, band_hz: tuple[float, float] | None = None,
+                        band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                         output: str | None = None) -> ResponseMaxima:
-        """The n+2 response maxima f_k of (4.71)-(4.73) over ``band`` (rad/s);
+        """The n+2 response maxima f_k of (4.71)-(4.73) over ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s);
         see :func:`railopt.models.response_maxima.response_maxima`."""
         from railopt.models.response_maxima import response_maxima
 
-        return response_maxima(self, band, exact=exact, output=output)
+        return response_maxima(self, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, output=output)
 
-    def peak(self, band: tuple[float, float], exact: bool = True, output: str | None = None) -> float:
-        """``U = max_k f_k`` (4.74) over ``band`` (rad/s); see :func:`railopt.models.response_maxima.peak`."""
+    def peak(self, band: object = None, *, band_hz: tuple[float, float] | None = None,
+             band_rad_s: tuple[float, float] | None = None, exact: bool = True, output: str | None = None) -> float:
+        """``U = max_k f_k`` (4.74) over ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s);
+        see :func:`railopt.models.response_maxima.peak`."""
         from railopt.models.response_maxima import peak
 
-        return peak(self, band, exact=exact, output=output)
+        return peak(self, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, output=output)
 
 
 @dataclass(frozen=True, eq=False)

@@ -54,18 +54,18 @@ def square_matrix(name: str, value: object, n: int | None = None) -> np.ndarray:
     return a
 
 
-def band(value: object, name: str = "band") -> tuple[float, float]:
-    """A frequency band (rad/s): exactly two finite edges, 0 ≤ Ω_l < Ω_u."""
+def band(value: object, name: str = "band", unit: str = "rad/s") -> tuple[float, float]:
+    """A frequency band in ``unit``: exactly two finite edges, 0 ≤ lower < upper."""
     try:
         edges = list(value)  # type: ignore[call-overload]
     except TypeError as exc:
-        raise ValueError(f"{name}: must be a pair (lower, upper) in rad/s, got {value!r}") from exc
+        raise ValueError(f"{name}: must be a pair (lower, upper) in {unit}, got {value!r}") from exc
     if len(edges) != 2:
-        raise ValueError(f"{name}: must be a pair (lower, upper) in rad/s, got {len(edges)} values")
+        raise ValueError(f"{name}: must be a pair (lower, upper) in {unit}, got {len(edges)} values")
     try:
         lo, hi = number(name, edges[0]), number(name, edges[1])
     except ValueError as exc:
-        raise ValueError(f"{exc} (band edges must be finite numbers in rad/s)") from None
+        raise ValueError(f"{exc} (band edges must be finite numbers in {unit})") from None
     if lo < 0:
         raise ValueError(f"{name}: lower edge must be ≥ 0, got {lo}")
     if not hi > lo:
@@ -103,3 +103,34 @@ def poisson(name: str, value: object) -> float:
     if not 0.0 <= x <= 0.5:
         raise ValueError(f"{name}: Poisson's ratio must lie in [0, 0.5], got {x}")
     return x
+
+
+AMBIGUOUS = object()  # the default of a positional band/frequency argument that must not be given
+
+
+def band_arg(positional: object = None, band_hz: object = None, band_rad_s: object = None) -> tuple[float, float]:
+    """The one frequency convention of railopt's public API: a band is given as ``band_hz=(lo, hi)`` in Hz or
+    ``band_rad_s=(lo, hi)`` in rad/s (exactly one); a positional ``band`` is refused, because (0.2, 5.0) in Hz
+    read as rad/s gives a 13× different answer without any sign of it.  Returns (lo, hi) in rad/s."""
+    if positional is not None:
+        raise ValueError("band: a positional band is ambiguous (Hz or rad/s?); give band_hz=(lo, hi) in Hz or "
+                         "band_rad_s=(lo, hi) in rad/s")
+    if (band_hz is None) == (band_rad_s is None):
+        raise ValueError("band_hz: give exactly one of band_hz=(lo, hi) in Hz or band_rad_s=(lo, hi) in rad/s")
+    if band_hz is not None:
+        lo, hi = band(band_hz, "band_hz", "Hz")
+        return 2.0 * math.pi * lo, 2.0 * math.pi * hi
+    return band(band_rad_s, "band_rad_s")
+
+
+def frequencies_arg(omega: object = None, frequencies_hz: object = None, omega_rad_s: object = None) -> np.ndarray:
+    """Forcing frequencies as ``frequencies_hz=`` (Hz) or ``omega_rad_s=`` (rad/s), exactly one; a positional
+    value is refused (see :func:`band_arg`).  Returns rad/s, 1-D."""
+    if omega is not None:
+        raise ValueError("omega: a positional frequency is ambiguous (Hz or rad/s?); give frequencies_hz= (Hz) or "
+                         "omega_rad_s= (rad/s)")
+    if (frequencies_hz is None) == (omega_rad_s is None):
+        raise ValueError("frequencies_hz: give exactly one of frequencies_hz= (Hz) or omega_rad_s= (rad/s)")
+    if frequencies_hz is not None:
+        return 2.0 * math.pi * frequencies_rad_s(frequencies_hz, "frequencies_hz")
+    return frequencies_rad_s(omega_rad_s, "omega_rad_s")

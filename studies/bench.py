@@ -53,7 +53,7 @@ def _median_time(fn: Callable[[], object], repeat: int) -> float:
 
 
 def _dense_peak(system, band: tuple[float, float], points: int) -> float:
-    return float(np.max(np.abs(system.frf(np.linspace(*band, points)))))
+    return float(np.max(np.abs(system.frf(omega_rad_s=np.linspace(*band, points)))))
 
 
 def random_chain(n: int, seed: int, damping: float = 0.02) -> LinearSystem:
@@ -118,8 +118,9 @@ def _cab_rows(repeat: int) -> list[dict]:
     band = config.objective.target(setup, exact=True).band
     reps = max(repeat // 4, 5)
     t_floor = _floor(cab, band, reps)
-    t_thesis = _median_time(lambda: _fresh(cab).response_maxima(band, output="cab_acceleration"), reps)
-    t_exact = _median_time(lambda: _fresh(cab).response_maxima(band, exact=True, output="cab_acceleration"), reps)
+    t_thesis = _median_time(lambda: _fresh(cab).response_maxima(band_rad_s=band, output="cab_acceleration"), reps)
+    t_exact = _median_time(
+        lambda: _fresh(cab).response_maxima(band_rad_s=band, exact=True, output="cab_acceleration"), reps)
     rows = [{"benchmark": f"U(x), cab model (n={cab.n}, {len(cab.forcing.terms)} forcing term(s)), thesis method",
              "ours_s": t_thesis,
              "reference_s": t_floor, "reference": "floor: eig(G) + (n+2) complex solves", "ratio": t_thesis / t_floor},
@@ -133,8 +134,8 @@ def _cab_rows(repeat: int) -> list[dict]:
     full = lateral.forced_system(Irregularity("alignment", 0.25 * INCH), ["cab.lateral"], quantity="acceleration")
     fband = (0.1 * RAD_PER_HZ, 3.0 * RAD_PER_HZ)
     t_ff = _floor(full, fband, reps)
-    t_ft = _median_time(lambda: _fresh(full).response_maxima(fband), reps)
-    t_fe = _median_time(lambda: _fresh(full).response_maxima(fband, exact=True), reps)
+    t_ft = _median_time(lambda: _fresh(full).response_maxima(band_rad_s=fband), reps)
+    t_fe = _median_time(lambda: _fresh(full).response_maxima(band_rad_s=fband, exact=True), reps)
     rows += [{"benchmark": f"U(x), full lateral model with creep (n={full.n}, 6 delayed axle inputs), thesis method",
               "ours_s": t_ft, "reference_s": t_ff, "reference": "floor: eig(G) + (n+2) complex solves",
               "ratio": t_ft / t_ff},
@@ -194,14 +195,14 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
 
     # 1. U(x) vs the floor -------------------------------------------------------------------
     t_floor = _floor(sys, band, repeat)
-    t_thesis = _median_time(lambda: ps.response_maxima(p, band), repeat)
-    t_exact = _median_time(lambda: ps.response_maxima(p, band, exact=True), max(repeat // 10, 5))
+    t_thesis = _median_time(lambda: ps.response_maxima(p, band_rad_s=band), repeat)
+    t_exact = _median_time(lambda: ps.response_maxima(p, band_rad_s=band, exact=True), max(repeat // 10, 5))
     rows.append({"benchmark": "U(x), thesis method, TMD (n=2)", "ours_s": t_thesis, "reference_s": t_floor,
                  "reference": "floor: eig(G) + (n+2) complex solves", "ratio": t_thesis / t_floor})
 
     # 2. thesis / exact vs dense sweep at equal accuracy ----------------------------------------
-    exact_peak = ps.response_maxima(p, band, exact=True).value
-    thesis_err = abs(ps.response_maxima(p, band).value - exact_peak) / exact_peak
+    exact_peak = ps.response_maxima(p, band_rad_s=band, exact=True).value
+    thesis_err = abs(ps.response_maxima(p, band_rad_s=band).value - exact_peak) / exact_peak
     dense_err_2000 = abs(_dense_peak(sys, band, 2000) - exact_peak) / exact_peak
     target = 1e-9
     n_dense = 2000
@@ -234,12 +235,12 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
         chain_band = (0.0, 1.2 * chain.damped_frequencies().max())
         reps = max(repeat // 4, 5)
         t_fl = _floor(chain, chain_band, reps)
-        t_th = _median_time(lambda c=chain, b=chain_band: _fresh(c).response_maxima(b), reps)
-        t_ex = _median_time(lambda c=chain, b=chain_band: _fresh(c).response_maxima(b, exact=True), reps)
+        t_th = _median_time(lambda c=chain, b=chain_band: _fresh(c).response_maxima(band_rad_s=b), reps)
+        t_ex = _median_time(lambda c=chain, b=chain_band: _fresh(c).response_maxima(band_rad_s=b, exact=True), reps)
         w = np.linspace(*chain_band, 4001)
-        direct = chain.frf_outputs(w)
+        direct = chain.frf_outputs(omega_rad_s=w)
         pr_err = float(np.max(np.abs(chain.pole_residue().evaluate(w) - direct)) / np.max(np.abs(direct)))
-        rm = chain.response_maxima(chain_band, exact=True)
+        rm = chain.response_maxima(band_rad_s=chain_band, exact=True)
         rows.append({"benchmark": f"exact certified U vs thesis U, non-symmetric n={size} ({rm.grid_points} "
                                   f"grid points)", "ours_s": t_ex, "reference_s": t_th,
                      "reference": "thesis-method U (eig + n+2 solves)", "ratio": t_ex / t_th,

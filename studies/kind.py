@@ -56,6 +56,9 @@ class StudyKind:
     compute: Callable[[Any, StudyContext], StudyResult]
     report: Callable[[Any, Writer], str]
     summary: str = ""
+    warnings: Callable[[Any], list[str]] | None = None
+    """``config -> [message, ...]``: things a run does not refuse but a user must hear of (e.g. an existing
+    design that hunts below its required speed); ``railopt validate`` and ``run`` print them as warnings."""
 
 
 KINDS: dict[str, StudyKind] = {}

@@ -21,15 +21,15 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_response_maxima_is_array_like_read_only_and_comparable():
     sys_ = random_system(3, 4)
-    rm = sys_.response_maxima((0.1, 2.0), exact=True)
+    rm = sys_.response_maxima(band_rad_s=(0.1, 2.0), exact=True)
     arr = np.asarray(rm)
     assert arr.dtype == float and arr.shape == (5,)
     np.testing.assert_array_equal(arr, rm.values)
     assert len(rm) == 5 and rm[-1] == rm.values[-1] and list(rm) == list(rm.values)
     with pytest.raises(ValueError):
         rm.values[0] = 1.0  # read-only
-    assert rm == sys_.response_maxima((0.1, 2.0), exact=True)
-    assert rm != sys_.response_maxima((0.1, 2.0), exact=False)
+    assert rm == sys_.response_maxima(band_rad_s=(0.1, 2.0), exact=True)
+    assert rm != sys_.response_maxima(band_rad_s=(0.1, 2.0), exact=False)
     assert len(repr(rm)) < 200 and "U=" in repr(rm)
     df = rm.to_pandas()
     np.testing.assert_array_equal(df["value"], rm.values)

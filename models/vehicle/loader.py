@@ -218,7 +218,8 @@ def _parse(data: Mapping[str, Any], path: str, length_overrides: Mapping[str, fl
 
     vehicle = Vehicle(name=name, description=f.vehicle.description, bodies=tuple(bodies),
                       elements=tuple(elements), constraints=tuple(constraints), contact=contact, track=track,
-                      cab_point=cab_point, lengths=Lengths(lengths, lsources), aliases={}, path=path)
+                      cab_point=cab_point, lengths=Lengths(lengths, lsources),
+                      clearances=Lengths(*_named_values(f.clearances, "clearances")), aliases={}, path=path)
     _check_aliases(vehicle, f.aliases)
     vehicle = Vehicle(**{**vehicle.__dict__, "aliases": dict(f.aliases), "_cache": {}})
     _check_contact(vehicle)

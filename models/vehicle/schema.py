@@ -289,6 +289,7 @@ class VehicleFileSchema(Strict):
     vehicle: HeadSchema
     lengths: dict[str, Length] = {}
     angles_deg: dict[str, Length] = {}
+    clearances: dict[str, Length] = {}
     aliases: dict[str, Str] = {}
     cab: CabSchema | None = None
     bodies: list[BodySchema]
@@ -301,7 +302,7 @@ class VehicleFileSchema(Strict):
 TABLES: dict[str, type[Strict]] = {
     "vehicle": HeadSchema, "cab": CabSchema, "bodies": BodySchema, "elements": ElementSchema,
     "constraints": ConstraintSchema, "contact": ContactSchema, "track": TrackSchema, "lengths": LengthSchema,
-    "angles_deg": LengthSchema,
+    "angles_deg": LengthSchema, "clearances": LengthSchema,
 }
 ARRAYS = ("bodies", "elements", "constraints")
 MISSING_HINTS = {"kind": ' (kind = "body" or "wheelset": a wheelset gets wheel/rail contact)'}

@@ -53,6 +53,7 @@ class Vehicle:
     track: TrackSpec | None = None
     cab_point: tuple[float, float, float] | None = None
     lengths: Lengths = field(default_factory=Lengths)
+    clearances: Lengths = field(default_factory=Lengths)
     aliases: dict[str, str] = field(default_factory=dict)
     path: str = ""
     _cache: dict = field(default_factory=dict, compare=False, repr=False, hash=False)

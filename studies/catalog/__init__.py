@@ -175,6 +175,10 @@ class ModelSetup:
     stability : mapping track -> ParametricSystem
         The vehicle's unforced lateral family on each track (speed term included), its parameters named
         as the family's (a subset of them): root loci and hunting checks.  Empty without forward speed.
+    required_speed : float or None
+        The speed (m/s) up to which a design must not hunt (the hunting check's maximum operating speed).
+    limits : mapping name -> float
+        Named limits of the model's outputs (the vehicle file's ``[clearances]``, m), for constraints.
     """
 
     family: ParametricSystem
@@ -183,6 +187,8 @@ class ModelSetup:
     checks: dict[str, Check] = field(default_factory=dict)
     stability: dict[str, ParametricSystem] = field(default_factory=dict)
     description: str = ""
+    required_speed: float | None = None
+    limits: dict[str, float] = field(default_factory=dict)
 
     @property
     def defaults(self) -> np.ndarray:

@@ -82,6 +82,8 @@ def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: S
                 "hunting": HuntingCheck(stability, names, search, max_speed)},
         stability=stability,
         description=description,
+        required_speed=max_speed,
+        limits=dict(vehicle.clearances.values),
     )
 
 

@@ -178,7 +178,7 @@ def _band_peaks(model, sys, irregularity, b: BandSpec, outputs: list[str], quant
     """output -> (peak, frequency in Hz, certified): certified band maxima of ``sys``, or (fixed wavelength,
     no one system) grid maxima refined by the shared peak search."""
     if sys is not None:
-        maxima = all_response_maxima(sys, (b.band_hz[0] * HZ, b.band_hz[1] * HZ), exact=True, outputs=outputs)
+        maxima = all_response_maxima(sys, band_hz=b.band_hz, exact=True, outputs=outputs)
         return {o: (rm.value, rm.argmax_frequency / HZ, rm.certified) for o, rm in maxima.items()}
     return {o: (*_grid_peak(model, irregularity, o, quantity, out.responses[(track, b.label, o)]), False)
             for o in outputs}

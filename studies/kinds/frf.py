@@ -109,8 +109,8 @@ def _model_curves(cfg: FRFStudyConfig, i: int, ref, f_hz: np.ndarray, band: tupl
         values = d.resolve(setup, f"designs[{j}]")
         p, _ = setup.parameters(list(values), np.array(list(values.values())))
         sys = setup.family.at(p)
-        H = sys.frf_outputs(f_hz * HZ)
-        maxima = all_response_maxima(sys, band, exact=True, outputs=outputs)
+        H = sys.frf_outputs(omega_rad_s=f_hz * HZ)
+        maxima = all_response_maxima(sys, band_rad_s=band, exact=True, outputs=outputs)
         for o in outputs:
             h = H[:, sys.output_index(o)]
             curves.append(pd.DataFrame({"model": ref.label, "design": d.label, "output": o, "frequency_hz": f_hz,

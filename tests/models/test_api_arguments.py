@@ -15,13 +15,13 @@ from conftest import random_system
 
 @pytest.mark.parametrize("omega", [np.nan, [1.0, np.inf], ["a"], "1.0", [True], -1.0, 1j])
 def test_frequencies_that_are_not_frequencies_are_named(omega) -> None:
-    with pytest.raises(ValueError, match="^omega: "):
-        random_system(3, seed=2).frf(omega)
+    with pytest.raises(ValueError, match="^omega_rad_s: "):
+        random_system(3, seed=2).frf(omega_rad_s=omega)
 
 
 def test_an_overflowing_frequency_is_an_error_not_a_nan() -> None:
-    with pytest.raises(ValueError, match="^omega: Z"):
-        random_system(3, seed=2).frf(1e200)
+    with pytest.raises(ValueError, match="^omega: Z"):  # the one check where Z(Ω) is formed
+        random_system(3, seed=2).frf(omega_rad_s=1e200)
 
 
 @pytest.mark.parametrize(("field", "value"), [("EI", "6e6"), ("k", True), ("m", None), ("c", [1.0]), ("N", np.nan)])

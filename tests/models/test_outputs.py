@@ -34,22 +34,23 @@ def test_each_output_equals_a_single_output_system():
     for name, out in sys.outputs.items():
         single = LinearSystem(sys.M, sys.C, sys.K, sys.forcing, out.row, response=out.quantity)
         for exact in (False, True):
-            a = sys.response_maxima(BAND, exact=exact, output=name)
-            b = single.response_maxima(BAND, exact=exact)
+            a = sys.response_maxima(band_rad_s=BAND, exact=exact, output=name)
+            b = single.response_maxima(band_rad_s=BAND, exact=exact)
             np.testing.assert_allclose(a.values, b.values, rtol=1e-13)
         w = np.linspace(0.1, 3.0, 50)
-        np.testing.assert_allclose(sys.frf(w, name), single.frf(w), rtol=1e-13)
+        np.testing.assert_allclose(sys.frf(omega_rad_s=w, output=name), single.frf(omega_rad_s=w), rtol=1e-13)
 
 
 @pytest.mark.parametrize("exact", [False, True])
 def test_gradients_of_every_output_match_finite_differences(exact):
     ps = two_output_system()
     sys = ps.at(P0)
-    result = maxima_jacobians(sys, BAND, exact=exact)
+    result = maxima_jacobians(sys, band_rad_s=BAND, exact=exact)
     assert set(result) == set(sys.output_names)
     for name, (rm, J) in result.items():
-        Jfd = central_difference(lambda q, name=name: ps.response_maxima(q, BAND, exact=exact, output=name).values, P0)
-        np.testing.assert_allclose(rm.values, ps.response_maxima(P0, BAND, exact=exact, output=name).values,
+        Jfd = central_difference(
+            lambda q, name=name: ps.response_maxima(q, band_rad_s=BAND, exact=exact, output=name).values, P0)
+        np.testing.assert_allclose(rm.values, ps.response_maxima(P0, band_rad_s=BAND, exact=exact, output=name).values,
                                    rtol=1e-14)
         np.testing.assert_allclose(J, Jfd, rtol=2e-5, atol=2e-6 * np.max(np.abs(Jfd)))
 
@@ -61,14 +62,14 @@ def test_one_eigen_decomposition_serves_every_output(monkeypatch):
     original = ls.modal
     monkeypatch.setattr(ls, "modal", lambda G: calls.append(1) or original(G))
     sys = two_output_system().at(P0)
-    maxima_jacobians(sys, BAND, exact=True)
+    maxima_jacobians(sys, band_rad_s=BAND, exact=True)
     assert len(calls) == 1
 
 
 def test_unknown_output_and_bad_rows_name_the_field():
     sys = two_output_system().at(P0)
     with pytest.raises(ValueError, match="^output: unknown output 'cab'"):
-        sys.response_maxima(BAND, output="cab")
+        sys.response_maxima(band_rad_s=BAND, output="cab")
     with pytest.raises(ValueError, match=r"^outputs\['z'\]: must be real"):
         LinearSystem(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], outputs={"z": [1j, 0.0]})
     with pytest.raises(ValueError, match=r"^outputs\['z'\].quantity"):
@@ -86,9 +87,10 @@ def test_feedthrough_gives_the_relative_displacement_of_a_base_excited_sdof():
     w = np.linspace(0.0, 3 * wn, 301)
     r = w / wn
     closed = r**2 / np.sqrt((1 - r**2) ** 2 + (2 * zeta * r) ** 2)
-    np.testing.assert_allclose(np.abs(sys.frf(w, "stroke")), closed, rtol=1e-11, atol=1e-14)
-    np.testing.assert_allclose(sys.pole_residue().evaluate(w)[:, 0], sys.frf(w, "stroke"), rtol=1e-10, atol=1e-14)
-    rm = sys.response_maxima((0.0, 3 * wn), exact=True, output="stroke")
+    np.testing.assert_allclose(np.abs(sys.frf(omega_rad_s=w, output="stroke")), closed, rtol=1e-11, atol=1e-14)
+    np.testing.assert_allclose(sys.pole_residue().evaluate(w)[:, 0], sys.frf(omega_rad_s=w, output="stroke"),
+                               rtol=1e-10, atol=1e-14)
+    rm = sys.response_maxima(band_rad_s=(0.0, 3 * wn), exact=True, output="stroke")
     # closed-form peak of r²/√(...): at r² = 1/(1 − 2ζ²), value 1/(2ζ√(1 − ζ²))
     assert rm.certified and rm.value == pytest.approx(1 / (2 * zeta * np.sqrt(1 - zeta**2)), rel=1e-10)
 
@@ -108,6 +110,7 @@ def test_feedthrough_gradients_match_finite_differences(exact):
     }, outputs={"stroke": (e0, "displacement", [-1.0]), "acc": (np.array([0.0, 1.0]), "acceleration")})
     p = np.array([2.0, 0.1])
     band = (0.1, 3.0)
-    for name, (_rm, J) in maxima_jacobians(ps.at(p), band, exact=exact).items():
-        Jfd = central_difference(lambda q, name=name: ps.response_maxima(q, band, exact=exact, output=name).values, p)
+    for name, (_rm, J) in maxima_jacobians(ps.at(p), band_rad_s=band, exact=exact).items():
+        Jfd = central_difference(
+            lambda q, name=name: ps.response_maxima(q, band_rad_s=band, exact=exact, output=name).values, p)
         np.testing.assert_allclose(J, Jfd, rtol=2e-5, atol=2e-6 * np.max(np.abs(Jfd)))

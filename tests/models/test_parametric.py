@@ -40,9 +40,9 @@ def test_damped_frequency_jacobian_matches_finite_differences():
 @pytest.mark.parametrize("p", [P0, np.array([1.0, 0.05, 2.0]), np.array([6.0, 0.6, 0.3])])
 def test_response_maxima_jacobian_matches_finite_differences(exact, p):
     ps = base_excited_parametric()
-    rm, J = ps.response_maxima_jacobian(p, BAND, exact=exact)
-    np.testing.assert_allclose(rm.values, ps.response_maxima(p, BAND, exact=exact).values, rtol=1e-14)
-    Jfd = central_difference(lambda q: ps.response_maxima(q, BAND, exact=exact).values, p)
+    rm, J = ps.response_maxima_jacobian(p, band_rad_s=BAND, exact=exact)
+    np.testing.assert_allclose(rm.values, ps.response_maxima(p, band_rad_s=BAND, exact=exact).values, rtol=1e-14)
+    Jfd = central_difference(lambda q: ps.response_maxima(q, band_rad_s=BAND, exact=exact).values, p)
     scale = np.max(np.abs(Jfd))
     np.testing.assert_allclose(J, Jfd, rtol=2e-5, atol=2e-6 * scale)
 

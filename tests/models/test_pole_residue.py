@@ -17,7 +17,7 @@ def test_pole_residue_equals_direct_solves(n):
     w = np.linspace(0.0, 1.3 * sys.damped_frequencies().max(), 3001)
     pr = sys.pole_residue()
     assert pr is not None and sys.modal().condition < CONDITION_LIMIT
-    direct = sys.frf_outputs(w)
+    direct = sys.frf_outputs(omega_rad_s=w)
     err = np.max(np.abs(pr.evaluate(w) - direct)) / np.max(np.abs(direct))
     assert err < 1e-10
 
@@ -25,7 +25,7 @@ def test_pole_residue_equals_direct_solves(n):
 def test_pole_residue_with_delays_polynomial_and_callable_terms():
     sys = delayed_system(4, 3, 7.0, seed=11)
     w = np.linspace(0.0, 4.0, 2001)
-    direct = sys.frf_outputs(w)
+    direct = sys.frf_outputs(omega_rad_s=w)
     np.testing.assert_allclose(sys.pole_residue().evaluate(w), direct, rtol=1e-10, atol=1e-12 * np.abs(direct).max())
     # the same forcing given as a callable amplitude (evaluated per frequency) gives the same H
     terms = [(lambda w, t=t: t.amplitude(w), t.delay) for t in sys.forcing.terms]
@@ -49,7 +49,7 @@ def test_defective_system_falls_back_to_direct_solves(detuning):
     sys = near_defective(detuning)
     assert sys.modal().condition > CONDITION_LIMIT
     assert sys.pole_residue() is None
-    rm = sys.response_maxima((0.0, 4.0), exact=True)
+    rm = sys.response_maxima(band_rad_s=(0.0, 4.0), exact=True)
     assert rm.evaluation == "direct"
     assert 1.9 < rm.argmax_frequency < 2.1
     assert rm.value == pytest.approx(brute_force_peak(sys, (0.0, 4.0)), rel=1e-10)
@@ -60,7 +60,7 @@ def test_moderately_ill_conditioned_system_keeps_pole_residue_and_direct_values(
     direct solve, so it is as accurate as for a well-conditioned system."""
     sys = near_defective(1e-7)
     assert 1e4 < sys.modal().condition < CONDITION_LIMIT
-    rm = sys.response_maxima((0.0, 4.0), exact=True)
+    rm = sys.response_maxima(band_rad_s=(0.0, 4.0), exact=True)
     assert rm.evaluation == "pole-residue"
     assert rm.value == pytest.approx(brute_force_peak(sys, (0.0, 4.0)), rel=1e-10)
 
@@ -74,7 +74,7 @@ def test_two_outputs_with_nearly_repeated_complex_roots():
     sys = LinearSystem(M, C, K, [1.0, 1.0], outputs={"a": [1.0, 0.0], "b": [1.0, 1.0]})
     assert sys.pole_residue() is not None
     for name in ("a", "b"):
-        rm = sys.response_maxima((0.0, 4.0), exact=True, output=name)
+        rm = sys.response_maxima(band_rad_s=(0.0, 4.0), exact=True, output=name)
         assert rm.evaluation == "pole-residue"
         assert rm.value == pytest.approx(brute_force_peak(LinearSystem(M, C, K, [1.0, 1.0], sys.outputs[name].row),
                                                           (0.0, 4.0)), rel=1e-10)

@@ -89,7 +89,7 @@ def test_quadrature_rule_is_reusable_and_error_controlled():
     assert r.rule.integrate(r.gain_squared * r.input_psd) == pytest.approx(r.variance, rel=1e-14)
     assert r.error_estimate <= 1e-10 * r.variance
     # |H|² at the nodes is |frf|², the input PSD is S(ω/V)/V
-    assert np.allclose(r.gain_squared, np.abs(system.frf(r.rule.omega)) ** 2, rtol=1e-12)
+    assert np.allclose(r.gain_squared, np.abs(system.frf(omega_rad_s=r.rule.omega)) ** 2, rtol=1e-12)
     assert np.allclose(r.input_psd, spec.psd(r.rule.omega / 30.0) / 30.0, rtol=1e-14)
     coarse = random_response(system, spec, 30.0, (0.5, 15.0), rtol=1e-4)
     assert coarse.rms == pytest.approx(r.rms, rel=1e-4)
@@ -104,7 +104,7 @@ def test_output_psd_units_integrate_to_the_variance():
                      limit=500)
     assert rms(system, spec, V, band) ** 2 == pytest.approx(var_hz, rel=1e-8)
     f = np.array([1.0, 3.0, 10.0])
-    expected = np.abs(system.frf(TWO_PI * f)) ** 2 * TWO_PI * spec.psd(TWO_PI * f / V) / V
+    expected = np.abs(system.frf(omega_rad_s=TWO_PI * f)) ** 2 * TWO_PI * spec.psd(TWO_PI * f / V) / V
     assert np.allclose(output_psd(system, spec, V, f), expected, rtol=1e-14)
 
 

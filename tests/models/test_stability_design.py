@@ -39,11 +39,11 @@ def test_an_unstable_system_has_no_certified_maximum() -> None:
     system = load_vehicle("manchester-coach").lateral("rigid", 100.0).forced_system(
         Irregularity("alignment", amplitude_m=0.001), ["cab.lateral"], quantity="acceleration")
     for exact in (True, False):
-        rm = system.response_maxima((1.2566, 62.83), exact=exact)
+        rm = system.response_maxima(band_rad_s=(1.2566, 62.83), exact=exact)
         assert not rm.certified
         assert rm.value == np.inf and np.all(np.isinf(rm.values))
         assert rm.reason.startswith("unstable: root s = 3.04") and "no steady-state response" in rm.reason
-    assert system.peak((1.2566, 62.83)) == np.inf
+    assert system.peak(band_rad_s=(1.2566, 62.83)) == np.inf
     table = load_vehicle("manchester-coach").lateral("rigid", 100.0).frequency_response(
         [1.0, 2.0], Irregularity("alignment", amplitude_m=0.001), ["cab.lateral"])
     assert not table["steady_state"].any()

@@ -34,23 +34,23 @@ def test_acceleration_of_free_masses_from_zero_hz_is_the_closed_form(m1, m2, k, 
     best = minimize_scalar(lambda w: -closed_form(np.array([w]), m1, m2, k, c)[0],
                            bounds=(grid[max(i - 1, 0)], grid[i + 1]), method="bounded", options={"xatol": 1e-12})
     reference = max(-best.fun, 1.0 / (m1 + m2))
-    rm = system.response_maxima(band, exact=True)
+    rm = system.response_maxima(band_rad_s=band, exact=True)
     assert rm.value == pytest.approx(reference, rel=1e-9)
     assert rm.certified and rm.reason == ""
     # the lower edge is the limit Ω → 0: the whole vehicle accelerates as one mass, 1/(m1 + m2)
     assert rm.values[-2] == pytest.approx(1.0 / (m1 + m2), rel=1e-7)
     assert rm.frequencies[-2] == 0.0
-    thesis = system.response_maxima(band, exact=False)
+    thesis = system.response_maxima(band_rad_s=band, exact=False)
     assert np.all(np.isfinite(thesis.values)) and thesis.values[-2] == pytest.approx(1.0 / (m1 + m2), rel=1e-7)
 
 
 def test_an_output_unbounded_at_zero_hz_is_refused_naming_the_band() -> None:
     system = free_masses(2.0, 1.0, 100.0, 0.4, "displacement")
     with pytest.raises(ValueError, match=r"^band: starts at 0 Hz, where the output\(s\) \['output'\] are unbounded"):
-        system.response_maxima((0.0, 10.0), exact=True)
+        system.response_maxima(band_rad_s=(0.0, 10.0), exact=True)
     with pytest.raises(ValueError, match="^band: starts at 0 Hz"):
-        system.peak((0.0, 10.0), exact=False)
-    assert np.isfinite(system.peak((0.1, 10.0)))  # above 0 it is an ordinary band
+        system.peak(band_rad_s=(0.0, 10.0), exact=False)
+    assert np.isfinite(system.peak(band_rad_s=(0.1, 10.0)))  # above 0 it is an ordinary band
 
 
 def test_locomotive_vertical_acceleration_from_zero_hz_equals_a_dense_sweep(sd40) -> None:
@@ -59,11 +59,11 @@ def test_locomotive_vertical_acceleration_from_zero_hz_equals_a_dense_sweep(sd40
                                                              ["body.w"], quantity="acceleration")
     assert np.sum(np.abs(system.eigenvalues()) < 1e-6) >= 7
     w = np.linspace(1e-3, 8 * HZ, 40001)
-    dense = np.abs(system.frf(w))
+    dense = np.abs(system.frf(omega_rad_s=w))
     i = int(np.argmax(dense))
-    best = minimize_scalar(lambda x: -abs(system.frf(x)), bounds=(w[i - 1], w[i + 1]), method="bounded",
+    best = minimize_scalar(lambda x: -abs(system.frf(omega_rad_s=x)), bounds=(w[i - 1], w[i + 1]), method="bounded",
                            options={"xatol": 1e-10})
-    rm = system.response_maxima((0.0, 8 * HZ), exact=True)
+    rm = system.response_maxima(band_rad_s=(0.0, 8 * HZ), exact=True)
     assert rm.value == pytest.approx(-best.fun, rel=1e-9)
     assert rm.value == pytest.approx(11.87859, rel=1e-6)  # the fault report's dense sweep
     assert rm.argmax_frequency / HZ == pytest.approx(2.304, abs=1e-3)

@@ -33,10 +33,10 @@ def test_quasi_static_input_carries_the_body_with_it(sd40):
     cab = cab_lateral_model(sd40, CabInput(mode="fixed_speed"))
     sys = cab.at()
     amp = 0.25 * INCH
-    assert abs(sys.frf(0.0, "cab_displacement")) == pytest.approx(amp, rel=1e-9)
-    assert abs(sys.frf(0.0, "body_roll")) < 1e-12
+    assert abs(sys.frf(omega_rad_s=0.0, output="cab_displacement")) == pytest.approx(amp, rel=1e-9)
+    assert abs(sys.frf(omega_rad_s=0.0, output="body_roll")) < 1e-12
     for frame in cab.frames:
-        assert abs(sys.frf(0.0, f"secondary_stroke_{frame}")) < 1e-12 * amp
+        assert abs(sys.frf(omega_rad_s=0.0, output=f"secondary_stroke_{frame}")) < 1e-12 * amp
 
 
 def test_cut_equals_the_body_block_of_the_lateral_model(sd40):
@@ -63,9 +63,9 @@ def test_residual_and_certified_peaks_of_every_output(sd40):
         F = sys.forcing.value(w)
         assert np.linalg.norm(sys.impedance(w) @ X - F) <= 1e-10 * np.linalg.norm(F)
     w = np.linspace(*BAND, 20_001)
-    sampled = np.abs(sys.frf_outputs(w)).max(axis=0)  # direct solves on a uniform grid, every output at once
+    sampled = np.abs(sys.frf_outputs(omega_rad_s=w)).max(axis=0)  # direct solves on a uniform grid, all outputs
     for k, name in enumerate(sys.output_names):
-        rm = sys.response_maxima(BAND, exact=True, output=name)
+        rm = sys.response_maxima(band_rad_s=BAND, exact=True, output=name)
         assert rm.certified and sampled[k] * (1 - 1e-12) <= rm.value <= sampled[k] * (1 + 1e-3)
 
 
@@ -102,7 +102,7 @@ def test_every_optimum_is_recomputed_by_a_fresh_vehicle(flagship):
     assert len(optima) >= 2
     for _, row in optima.iterrows():
         vehicle = load_vehicle("sd40-2").with_parameters({n: float(row[n]) for n in names})
-        U = vehicle.cab_lateral().peak(BAND, exact=row["objective"] == "exact")
+        U = vehicle.cab_lateral().peak(band_rad_s=BAND, exact=row["objective"] == "exact")
         assert U == pytest.approx(row["value"], rel=1e-9)
         assert "hunting" in row and isinstance(row["stable"], bool | np.bool_)
 
@@ -124,8 +124,8 @@ def test_pareto_rows_are_dominated_by_nothing_computed(flagship):
     for s in starts:
         x = dict(zip(names, json.loads(s["x_json"]), strict=True))
         sys = load_vehicle("sd40-2").with_parameters(x).cab_lateral()
-        points.append((sys.peak(BAND, output="cab_acceleration"),
-                       sys.peak(BAND, output="secondary_stroke_frame_front")))
+        points.append((sys.peak(band_rad_s=BAND, output="cab_acceleration"),
+                       sys.peak(band_rad_s=BAND, output="secondary_stroke_frame_front")))
     for _, r in pareto.iterrows():
         for U, stroke in points:
             dominated = U <= r["U"] and stroke <= r["secondary_stroke_frame_front"] and (
@@ -146,7 +146,7 @@ def test_critical_speed_pareto_rows_are_dominated_by_nothing_computed(flagship):
     table = pd.read_csv(out / "tradeoff_critical_speed.csv")
     for _, row in table[table["source"] == "start"].iterrows():
         vehicle = load_vehicle("sd40-2").with_parameters({n: float(row[n]) for n in names})
-        U = vehicle.cab_lateral().peak(BAND, output="cab_acceleration")
+        U = vehicle.cab_lateral().peak(band_rad_s=BAND, output="cab_acceleration")
         speed = min(critical_speed(vehicle, t, (2 * MPH, 300 * MPH), tol=0.01, grid=16).speed
                     for t in ("rigid", "flexible"))
         assert U == pytest.approx(row["U"], rel=1e-9) and speed == pytest.approx(row["hunting"], abs=0.02)
@@ -161,7 +161,7 @@ def test_summary_reports_before_after_and_flags(flagship):
     ba = pd.read_csv(out / "before_after.csv").set_index("output")
     acc = ba.loc["cab_acceleration"]
     assert acc["after"] < acc["before"] and acc["before_in"] == pytest.approx(acc["before"] / INCH, rel=1e-12)
-    existing = load_vehicle("sd40-2").cab_lateral().peak(BAND, output="cab_acceleration")
+    existing = load_vehicle("sd40-2").cab_lateral().peak(band_rad_s=BAND, output="cab_acceleration")
     assert acc["before"] == pytest.approx(existing, rel=1e-12)
     stab = pd.read_csv(out / "stability.csv").set_index("design")
     for design in ("before", "after"):

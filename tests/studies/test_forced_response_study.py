@@ -61,7 +61,7 @@ def test_small_study_tables_match_the_model(tmp_path):
     for track, col in (("rigid", "rigid_peak"), ("flexible", "flexible_peak")):
         sys = v.vertical(track, speed=25.0).forced_system(irr, ["body.w", "motor3.beta"])
         for o in ("body.w", "motor3.beta"):
-            assert peaks.loc[o, col] == pytest.approx(sys.peak((0.01 * HZ, 6.0 * HZ), output=o), rel=1e-12)
+            assert peaks.loc[o, col] == pytest.approx(sys.peak(band_rad_s=(0.01 * HZ, 6.0 * HZ), output=o), rel=1e-12)
     assert peaks["certified"].all()
     assert np.allclose(peaks["flexible_over_rigid"], peaks["flexible_peak"] / peaks["rigid_peak"])
     frf = pd.read_csv(out / "frf.csv")

@@ -11,7 +11,7 @@ from pydantic import Field, field_validator, model_validator
 
 from railopt.design import DesignVariable
 from railopt.models.units import RAD_PER_HZ
-from railopt.studies.adapter import ResponseTarget
+from railopt.studies.adapter import ResponseTarget, StabilityTarget
 from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
 from railopt.studies.config import BandHz, FiniteModel, MethodName, StrictModel
 
@@ -23,6 +23,7 @@ __all__ = [
     "OutputSpec",
     "ReportSpec",
     "SolverOptions",
+    "StabilitySpec",
     "SurfaceSpec",
     "TradeoffSpec",
     "VariableSpec",
@@ -76,10 +77,49 @@ class OutputSpec(FiniteModel):
 
 
 class ConstraintSpec(OutputSpec):
-    """f_k of ``output`` ≤ ``limit`` (units of the output) — the ε of ε-constraint sweeps."""
+    """f_k of ``output`` ≤ ``limit`` (units of the output), or ≤ the model's named ``clearance`` (the vehicle
+    file's ``[clearances]``, m) — the ε of ε-constraint sweeps."""
 
-    limit: float = Field(gt=0)
+    limit: float | None = Field(None, gt=0)
+    clearance: str | None = Field(None, description="a named limit of the model, e.g. secondary_lateral_m")
     exact: bool = True
+
+    @model_validator(mode="after")
+    def _one_limit(self) -> ConstraintSpec:
+        if (self.limit is None) == (self.clearance is None):
+            raise ValueError("give exactly one of limit (a number in the output's units) or clearance (a name)")
+        return self
+
+    def limit_value(self, setup: ModelSetup) -> float:
+        return self.limit if self.limit is not None else setup.limits[self.clearance]
+
+
+class StabilitySpec(FiniteModel):
+    """``[stability]``: the stability constraints of the constrained problem (SPEC §2.5).
+
+    Every vehicle mode's root must satisfy Re s + σ_min ≤ 0 at ``speeds`` speeds evenly spaced up to the
+    required speed (``required_speed_m_s``, default the model's maximum operating speed), on each of ``tracks``
+    (default: every track of the model's stability families); track modes and the modes named in ``exclude``
+    are left out; with ``zeta_min`` every kept mode is also at least that damped.  Each optimum's critical
+    speeds are then confirmed by the hunting check.
+    """
+
+    speeds: int = Field(4, ge=1, le=50, strict=True)
+    sigma_min: float = Field(0.0, ge=0, description="1/s")
+    zeta_min: float | None = Field(None, ge=0, lt=1)
+    required_speed_m_s: float | None = Field(None, gt=0, lt=1000)
+    tracks: list[Literal["rigid", "flexible"]] = Field(default_factory=list)
+    exclude: list[str] = Field(default_factory=list, description="mode names (or name prefixes) left out")
+
+    def required(self, setup: ModelSetup) -> float:
+        return self.required_speed_m_s or setup.required_speed
+
+    def target(self, setup: ModelSetup, required: float | None = None) -> StabilityTarget:
+        """The rows at ``speeds`` speeds up to ``required`` (m/s; default :meth:`required`)."""
+        top = required or self.required(setup)
+        speeds = tuple(float(v) for v in np.linspace(top / self.speeds, top, self.speeds))
+        return StabilityTarget(tuple(self.tracks or setup.stability), speeds, self.sigma_min, self.zeta_min,
+                               tuple(self.exclude))
 
 
 class CampaignDesign(CampaignSettings):
@@ -88,6 +128,9 @@ class CampaignDesign(CampaignSettings):
     variables: list[VariableSpec] = Field(min_length=1)
     methods: list[MethodName] = Field(default=["slsqp"], min_length=1)
     objectives: list[Literal["thesis", "exact"]] = Field(default=["exact"], min_length=1)
+    problems: list[Literal["constrained", "unconstrained"]] = Field(
+        default=["constrained"], min_length=1,
+        description="constrained: subject to [[constraints]] and [stability]; unconstrained: the objective alone")
     start_from: list[str] = Field(default_factory=list, description="named designs of each model used as starts")
     points: list[dict[str, float]] = Field(default_factory=list, description="explicit starts {variable: value}")
     checks: list[str] = Field(default_factory=lambda: ["spectral_abscissa"], description="checks of each optimum")
@@ -98,7 +141,7 @@ class CampaignDesign(CampaignSettings):
     def _no_single_method(cls, v: str) -> str:
         raise ValueError(f"this kind runs every entry of `methods`; write methods = [{v!r}] instead")
 
-    @field_validator("methods", "objectives")
+    @field_validator("methods", "objectives", "problems")
     @classmethod
     def _unique(cls, v: list[str]) -> list[str]:
         if len(set(v)) != len(v):
@@ -119,7 +162,9 @@ class ReportSpec(StrictModel):
 
 
 class TradeoffSpec(FiniteModel):
-    """One ε-constraint sweep: a constraint output (g = its f_k ≤ ε) or a check (value ≥ ε)."""
+    """One constraint sweep: a constraint output (g = its f_k ≤ ε), the ``hunting`` check (the constrained
+    problem with its stability rows up to each required speed ε, m/s, and the critical speed confirmed), or
+    another check (value ≥ ε, derivative-free)."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     output: str | None = None
@@ -133,7 +178,7 @@ class TradeoffSpec(FiniteModel):
     def _one(self) -> TradeoffSpec:
         if (self.output is None) == (self.check is None):
             raise ValueError(f"tradeoffs.{self.name}: give exactly one of output or check")
-        if self.check is not None and self.method != "cobyla":
+        if self.check not in (None, "hunting") and self.method != "cobyla":
             raise ValueError(f"tradeoffs.{self.name}.method: a check is not differentiable; use method = 'cobyla'")
         return self
 
@@ -151,6 +196,7 @@ class CampaignStudyConfig(ModelsStudy):
     KIND: ClassVar[str] = "campaign"
     objective: OutputSpec
     constraints: list[ConstraintSpec] = Field(default_factory=list)
+    stability: StabilitySpec | None = None
     design: CampaignDesign
     report: ReportSpec = ReportSpec()
     tradeoffs: list[TradeoffSpec] = Field(default_factory=list)
@@ -204,6 +250,20 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
     for t in cfg.tradeoffs:
         if t.check is not None and t.check not in setup.checks:
             raise ValueError(f"tradeoffs.{t.name}.check: {where} has no check {t.check!r}")
+        if t.check == "hunting" and not setup.stability:
+            raise ValueError(f"tradeoffs.{t.name}.check: {where} has no stability family to sweep against")
+    for i, c in enumerate(cfg.constraints):
+        if c.clearance is not None and c.clearance not in setup.limits:
+            raise ValueError(f"constraints[{i}].clearance: {where} has no clearance {c.clearance!r}; it has "
+                             f"{sorted(setup.limits)} (the vehicle file's [clearances])")
+    if cfg.stability is not None:
+        if not setup.stability:
+            raise ValueError(f"stability: {where} has no forward speed (no stability family to constrain)")
+        bad = [t for t in cfg.stability.tracks if t not in setup.stability]
+        if bad:
+            raise ValueError(f"stability.tracks: {bad} are not tracks of {where}; it has {sorted(setup.stability)}")
+        if cfg.stability.required(setup) is None:
+            raise ValueError(f"stability.required_speed_m_s: {where} has no maximum operating speed; give one")
     for sp in cfg.surfaces:
         bad = [v for v in sp.variables if v not in names]
         if bad or sp.variables[0] == sp.variables[1]:

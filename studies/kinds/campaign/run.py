@@ -115,16 +115,28 @@ def check_optima(optima: pd.DataFrame, setup: ModelSetup, names: list[str], labe
 
 
 # ---------------------------------------------------------------------------------------------- problems
-def campaign_label(model: str, objective: str, method: str) -> str:
-    return f"{model}-{objective}-{method}"
+def campaign_label(model: str, objective: str, method: str, problem: str = "constrained") -> str:
+    """The store name of a campaign: ``<model>-<objective>-<method>``, with ``-unconstrained`` after the model for
+    the unconstrained problem of a study that has constraints."""
+    return f"{model}-{objective}-{method}" if problem == "constrained" else f"{model}-{problem}-{objective}-{method}"
 
 
-def campaign_problem(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str) -> MinimaxProblem:
-    """The minimax problem of one model and objective kind ("thesis" or "exact")."""
+def campaign_problem(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str, problem: str = "constrained",
+                     required_speed: float | None = None, limits: dict[int, float] | None = None) -> MinimaxProblem:
+    """The minimax problem of one model, objective kind ("thesis" or "exact") and problem: "constrained" (the
+    config's ``[[constraints]]`` and ``[stability]``) or "unconstrained" (the objective alone).  A sweep changes
+    the required speed of the stability rows (``required_speed``, m/s) or a constraint's limit (``limits``)."""
     exact = objective == "exact"
+    variables = [v.variable() for v in cfg.design.variables]
+    target = cfg.objective.target(setup, exact)
+    if problem == "unconstrained":
+        return minimax_problem(setup, variables, target)
     constraints = [c.target(setup, c.exact) for c in cfg.constraints]
-    return minimax_problem(setup, [v.variable() for v in cfg.design.variables], cfg.objective.target(setup, exact),
-                           constraints, [c.limit for c in cfg.constraints])
+    values = [c.limit_value(setup) for c in cfg.constraints]
+    for i, value in (limits or {}).items():
+        values[i] = value
+    stability = None if cfg.stability is None else cfg.stability.target(setup, required_speed)
+    return minimax_problem(setup, variables, target, constraints, values, stability)
 
 
 def _p(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, float]) -> np.ndarray:
@@ -135,7 +147,7 @@ def _p(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, float]) ->
 def design_peak(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, float]) -> float:
     """Certified band maximum of the objective output at a design {variable: value}."""
     target = cfg.objective.target(setup, exact=True)
-    return setup.family.at(_p(cfg, setup, values)).peak(target.band, exact=True, output=target.output)
+    return setup.family.at(_p(cfg, setup, values)).peak(band_rad_s=target.band, exact=True, output=target.output)
 
 
 def _starts(cfg: CampaignStudyConfig, setup: ModelSetup) -> list[list[float]] | None:
@@ -146,12 +158,12 @@ def _starts(cfg: CampaignStudyConfig, setup: ModelSetup) -> list[list[float]] | 
 
 
 # ---------------------------------------------------------------------------------------------- comparison
-def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str], table: pd.DataFrame,
-                    optima: pd.DataFrame, flags: list[str]) -> dict:
+def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str, str],
+                    table: pd.DataFrame, optima: pd.DataFrame, flags: list[str]) -> dict:
     names = [v.name for v in cfg.design.variables]
-    model, objective, method = key
+    model, problem, objective, method = key
     ok = table[table["success"]]
-    row: dict = {"model": model, "objective": objective, "method": method, "starts": len(table),
+    row: dict = {"model": model, "problem": problem, "objective": objective, "method": method, "starts": len(table),
                  "converged": int(table["success"].sum()), "success_rate": float(table["success"].mean()),
                  "distinct_optima": len(optima), "evaluations": int(table["evaluations"].sum()),
                  "wall_time_s": float(table["wall_time"].sum())}
@@ -168,16 +180,17 @@ def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str,
             ref_values = setup.named_designs[ref]
             ref_peak = design_peak(cfg, setup, ref_values)
             row[f"{ref}_peak"] = ref_peak
-            row[f"rel_err_vs_{ref}"] = (peak - ref_peak) / ref_peak
+            row[f"change_vs_{ref}"] = (peak - ref_peak) / ref_peak
             for n in names:
-                row[f"{n}_err_vs_{ref}"] = values[n] - ref_values[n]
+                row[f"{n}_change_vs_{ref}"] = values[n] - ref_values[n]
+        row["active_bounds"] = "; ".join(_active_bounds(cfg, values)) or "none"
     return row
 
 
 def _short(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
-    cols = ["model", "objective", "method", *names, "U_objective", "true_peak", "converged", "starts",
+    cols = ["model", "problem", "objective", "method", *names, "U_objective", "true_peak", "converged", "starts",
             "distinct_optima"]
-    cols += [c for c in comparison.columns if c.startswith("rel_err_vs_")]
+    cols += [c for c in comparison.columns if c.startswith("change_vs_")]
     return comparison[[c for c in cols if c in comparison.columns]]
 
 
@@ -192,13 +205,16 @@ def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], compari
         for ref in cfg.report.compare:
             curves.append((f"{ref} (peak {design_peak(cfg, setup, setup.named_designs[ref]):.6g})", f_hz,
                            np.abs(setup.family.at(_p(cfg, setup, setup.named_designs[ref])).frf(
-                               f_hz * HZ, target.output)), "ref"))
+                               omega_rad_s=f_hz * HZ, output=target.output)), "ref"))
         for _, r in comparison[comparison["model"] == model].iterrows():
             if not np.isfinite(r.get("true_peak", np.nan)):
                 continue
             p = _p(cfg, setup, {n: r[n] for n in names})
-            curves.append((f"railopt {r['objective']}/{r['method']} (peak {r['true_peak']:.6g})", f_hz,
-                           np.abs(setup.family.at(p).frf(f_hz * HZ, target.output)), r["objective"]))
+            label = f"{r['problem']} {r['objective']}/{r['method']}" if len(cfg.design.problems) > 1 else \
+                f"railopt {r['objective']}/{r['method']}"
+            curves.append((f"{label} (peak {r['true_peak']:.6g})", f_hz,
+                           np.abs(setup.family.at(p).frf(frequencies_hz=f_hz, output=target.output)),
+                           r["objective"]))
         panels.append((f"{model}: {setup.description}", f"|H| of {target.output}", curves))
     return panels
 
@@ -256,8 +272,8 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
     outputs = cfg.report.outputs or [cfg.objective.target(setup, True).output]
     rows = []
     for o in outputs:
-        rb = sys_b.response_maxima(band, exact=True, output=o)
-        ra = sys_a.response_maxima(band, exact=True, output=o)
+        rb = sys_b.response_maxima(band_rad_s=band, exact=True, output=o)
+        ra = sys_a.response_maxima(band_rad_s=band, exact=True, output=o)
         row = {"output": o, "before": rb.value, "after": ra.value, "reduction_factor": rb.value / ra.value,
                "before_at_hz": rb.argmax_frequency / HZ, "after_at_hz": ra.argmax_frequency / HZ,
                "certified": rb.certified and ra.certified}
@@ -273,7 +289,8 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
     for o in outputs:
         suffix = {"displacement": "", "velocity": "/s", "acceleration": "/s²"}[sys_a.outputs[o].quantity]
         inch = o in cfg.report.inch_outputs
-        before, after_h = np.abs(sys_b.frf(f_hz * HZ, o)), np.abs(sys_a.frf(f_hz * HZ, o))
+        before = np.abs(sys_b.frf(frequencies_hz=f_hz, output=o))
+        after_h = np.abs(sys_a.frf(frequencies_hz=f_hz, output=o))
         if inch:
             before, after_h = m_to_in(before), m_to_in(after_h)
         frfs.append((o, f_hz, before, after_h, f"in{suffix}" if inch else "SI units"))
@@ -282,8 +299,9 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
         speeds = np.linspace(*cfg.report.locus_speeds_m_s, 80)
         loci = {label: root_locus(setup.stability_model(p), speeds).to_pandas()
                 for label, p in (("before", p_before), ("after", p_after))}
-    return BeforeAfter(pd.DataFrame(rows), sys_a.response_maxima(band, exact=False, output=objective_output).value,
-                       sys_a.response_maxima(band, exact=True, output=objective_output).value,
+    thesis = sys_a.response_maxima(band_rad_s=band, exact=False, output=objective_output).value
+    return BeforeAfter(pd.DataFrame(rows), thesis,
+                       sys_a.response_maxima(band_rad_s=band, exact=True, output=objective_output).value,
                        _active_bounds(cfg, after), frfs,
                        _check_rows(cfg, setup, {"before": p_before, "after": p_after}), loci)
 

@@ -70,7 +70,7 @@ def test_sdof_base_excited_transmissibility() -> None:
         H = df["real"].to_numpy() + 1j * df["imag"].to_numpy()
         assert np.max(np.abs(H - (1j * w) ** q * T) / np.abs((1j * w) ** q * T)) < 1e-12
     sys = model.forced_system(VERTICAL, ["body.w"])
-    peak = sys.response_maxima((0.1 * HZ, 10 * HZ), exact=True)
+    peak = sys.response_maxima(band_rad_s=(0.1 * HZ, 10 * HZ), exact=True)
     zeta = c / (2 * np.sqrt(k * m))  # closed-form peak of |T|: at r² = (√(1 + 8ζ²) − 1)/(4ζ²)
     r2 = (np.sqrt(1 + 8 * zeta**2) - 1) / (4 * zeta**2)
     t_peak = np.sqrt((1 + 4 * zeta**2 * r2) / ((1 - r2) ** 2 + 4 * zeta**2 * r2))
@@ -257,10 +257,11 @@ def test_unreduced_system_with_multipliers(sd40, track: str) -> None:
 def brute_force_peak(sys: LinearSystem, band: tuple[float, float], output: str, points: int = 20_001) -> float:
     """A uniform sweep by direct solves (chunked), every local maximum refined by scipy's bounded Brent."""
     w = np.linspace(*band, points)
-    a = np.concatenate([np.abs(sys.frf(w[i:i + 2000], output)) for i in range(0, points, 2000)])
+    a = np.concatenate([np.abs(sys.frf(omega_rad_s=w[i:i + 2000], output=output)) for i in range(0, points, 2000)])
     best = max(a[0], a[-1])
     for k in np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1:
-        r = minimize_scalar(lambda x: -abs(sys.frf(x, output)), bounds=(w[k - 1], w[k + 1]), method="bounded",
+        r = minimize_scalar(lambda x: -abs(sys.frf(omega_rad_s=x, output=output)), bounds=(w[k - 1], w[k + 1]),
+                            method="bounded",
                             options={"xatol": 1e-12})
         best = max(best, -r.fun, a[k])
     return float(best)
@@ -274,7 +275,7 @@ def test_certified_peak_equals_brute_force(sd40, track: str) -> None:
     assert sys.forcing.declared and sys.forcing.max_delay == pytest.approx(2 * (6.629 + 2.07) / S)
     band = (0.1 * HZ, 8.0 * HZ)
     for out in ("body.w", "motor3.beta"):
-        rm = sys.response_maxima(band, exact=True, output=out)
+        rm = sys.response_maxima(band_rad_s=band, exact=True, output=out)
         assert rm.certified
         assert rm.value == pytest.approx(brute_force_peak(sys, band, out), rel=1e-8)
 
@@ -332,17 +333,18 @@ def test_parametric_matches_forced_system(sd40) -> None:
     p = np.array([3.1e6, 2.0e4, 2.0e4, 4.0e6])
     ref = forced_system(model.with_values(dict(zip(names, p, strict=True))), VERTICAL, ["body.w", "motor3.beta"])
     w = HZ * np.linspace(0.2, 70.0, 50)
-    assert np.allclose(ps.at(p).frf_outputs(w), ref.frf_outputs(w), rtol=1e-11, atol=1e-15)
+    assert np.allclose(ps.at(p).frf_outputs(omega_rad_s=w), ref.frf_outputs(omega_rad_s=w), rtol=1e-11, atol=1e-15)
     band = (0.2 * HZ, 8.0 * HZ)
     sys = ps.at(p)
-    (rm, J), = maxima_jacobians(sys, band, exact=True, outputs=["body.w"]).values()
+    (rm, J), = maxima_jacobians(sys, band_rad_s=band, exact=True, outputs=["body.w"]).values()
     k = int(np.argmax(rm.values))
     for i in range(len(names)):
         h = 1e-4 * p[i]
         up, dn = p.copy(), p.copy()
         up[i] += h
         dn[i] -= h
-        fd = (ps.at(up).peak(band, output="body.w") - ps.at(dn).peak(band, output="body.w")) / (2 * h)
+        fd = ps.at(up).peak(band_rad_s=band, output="body.w") - ps.at(dn).peak(band_rad_s=band, output="body.w")
+        fd /= 2 * h
         assert J[k, i] == pytest.approx(fd, rel=2e-4, abs=1e-6 * rm.value / p[i])
 
 
@@ -413,7 +415,7 @@ def test_outputs_with_the_input_itself_feedthrough(sd40, track: str) -> None:
     outs = ["wheelset3.w", stroke, "body.w"]
     sys = model.forced_system(VERTICAL, outs)
     f = np.linspace(0.1, 70.0, 200)
-    H = sys.frf_outputs(HZ * f)
+    H = sys.frf_outputs(omega_rad_s=HZ * f)
     df = model.frequency_response(f, VERTICAL, outs)
     for j, o in enumerate(outs):
         d = df[df["output"] == o]
@@ -422,7 +424,7 @@ def test_outputs_with_the_input_itself_feedthrough(sd40, track: str) -> None:
     parts = model.frequency_response(f, VERTICAL, ["frame_rear.w", "frame_rear.beta", "wheelset3.w"])
     p = {o: (g["real"] + 1j * g["imag"]).to_numpy() for o, g in parts.groupby("output")}
     assert np.allclose(H[:, 1], p["frame_rear.w"] - 2.07 * p["frame_rear.beta"] - p["wheelset3.w"], rtol=1e-12)
-    rm = sys.response_maxima((0.1 * HZ, 8 * HZ), exact=True, output="wheelset3.w")
+    rm = sys.response_maxima(band_rad_s=(0.1 * HZ, 8 * HZ), exact=True, output="wheelset3.w")
     assert rm.certified
     if track == "rigid":
         assert np.allclose(np.abs(H[:, 0]), 1.0, rtol=1e-14) and rm.value == pytest.approx(1.0, rel=1e-14)
