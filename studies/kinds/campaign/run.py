@@ -320,7 +320,8 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
     objective (or of the first objective when exact is not run)."""
     names = [v.name for v in cfg.design.variables]
     objective = "exact" if "exact" in cfg.design.objectives else cfg.design.objectives[0]
-    rows = comparison[(comparison["model"] == model) & (comparison["objective"] == objective)]
+    rows = comparison[(comparison["model"] == model) & (comparison["objective"] == objective)
+                      & (comparison["problem"] == cfg.design.problems[0])]
     rows = rows[np.isfinite(rows.get("true_peak", pd.Series(dtype=float)))]
     if rows.empty:
         return ModelSections(model, tag, None, objective)
@@ -329,7 +330,7 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
     problem = campaign_problem(cfg, setup, objective)
     band = cfg.objective.target(setup, exact=True).band
     before_after = _before_after(cfg, setup, after, band) if cfg.report.before else None
-    starts = pd.concat([t for (m, o, _), t in tables.items() if m == model and o == objective])
+    starts = pd.concat([t for (m, prob, o, _), t in tables.items() if m == model and o == objective])
     target = cfg.objective.target(setup, exact=objective == "exact")
     hunting_after = _after_check(cfg, setup, after)
     tradeoffs = [tradeoff_table(problem, setup, target, spec, band, starts, cfg.design.seed, client, hunting_after)
@@ -353,16 +354,16 @@ class CampaignResult:
     sections: list[ModelSections]
 
 
-def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str], context: StudyContext,
+def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str, str], context: StudyContext,
               client) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
-    """One campaign (model, objective, method): its starts, its checked distinct optima and their flags."""
-    model, objective, method = key
+    """One campaign (model, problem, objective, method): its starts, its checked distinct optima and their flags."""
+    model, kind, objective, method = key
     names = [v.name for v in cfg.design.variables]
-    problem = campaign_problem(cfg, setup, objective)
-    label = campaign_label(*key)
+    problem = campaign_problem(cfg, setup, objective, kind)
+    label = campaign_label(model, objective, method, kind)
     settings = cfg.design.model_copy(update={"method": method})
     store_config = {**cfg.model_dump(mode="json"), "campaign": {"model": model, "objective": objective,
-                                                                 "method": method}}
+                                                                 "method": method, "problem": kind}}
     table = run_campaign(problem, label, settings, context, store_config, client, _starts(cfg, setup))
     found = distinct_optima(table, problem).rename(columns={"best_start": "start_id"})
     flags: list[str] = []
@@ -376,10 +377,11 @@ def compute(config: CampaignStudyConfig, context: StudyContext) -> CampaignResul
     cfg = config
     setups = cfg.setups()
     names = [v.name for v in cfg.design.variables]
-    keys = [(m, o, meth) for m in setups for o in cfg.design.objectives for meth in cfg.design.methods]
-    check_stores(context, [campaign_label(*k) for k in keys])
-    tables: dict[tuple[str, str, str], pd.DataFrame] = {}
-    optima: dict[tuple[str, str, str], pd.DataFrame] = {}
+    keys = [(m, prob, o, meth) for m in setups for prob in cfg.design.problems for o in cfg.design.objectives
+            for meth in cfg.design.methods]
+    check_stores(context, [campaign_label(m, o, meth, prob) for m, prob, o, meth in keys])
+    tables: dict[tuple[str, str, str, str], pd.DataFrame] = {}
+    optima: dict[tuple[str, str, str, str], pd.DataFrame] = {}
     rows = []
     with dask_context(context) as client:
         for key in keys:
@@ -390,9 +392,10 @@ def compute(config: CampaignStudyConfig, context: StudyContext) -> CampaignResul
         if cfg.report.before or cfg.tradeoffs or cfg.surfaces:
             sections = [_model_sections(cfg, m, s, comparison, tables, "" if len(setups) == 1 else f"_{m}", client)
                         for m, s in setups.items()]
-    starts = pd.concat([t.drop(columns=["functions"], errors="ignore").assign(model=m, objective=o, method=meth)
-                        for (m, o, meth), t in tables.items()], ignore_index=True)
-    optima_table = pd.concat([t.assign(model=m, objective=o, method=meth) for (m, o, meth), t in optima.items()],
-                             ignore_index=True)
+    starts = pd.concat([t.drop(columns=["functions"], errors="ignore").assign(model=m, problem=prob, objective=o,
+                                                                             method=meth)
+                        for (m, prob, o, meth), t in tables.items()], ignore_index=True)
+    optima_table = pd.concat([t.assign(model=m, problem=prob, objective=o, method=meth)
+                              for (m, prob, o, meth), t in optima.items()], ignore_index=True)
     return CampaignResult(cfg, comparison, starts, optima_table, _short(comparison, names),
                           _frf_panels(cfg, setups, comparison), sections)
