@@ -16,14 +16,14 @@ import importlib
 import pkgutil
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Protocol
+from typing import Annotated, Any, ClassVar, Protocol
 
 import numpy as np
-from pydantic import BaseModel, Field, model_validator
+from pydantic import AfterValidator, BaseModel, Field, model_validator
 
 from railopt.models import ParametricSystem
 from railopt.models.stability import critical_speed, least_damping, spectral_abscissa
-from railopt.studies.config import StrictModel, StudyHeader, field_errors
+from railopt.studies.config import Interval, StrictModel, StudyHeader, field_errors
 
 __all__ = [
     "MODELS",
@@ -36,6 +36,7 @@ __all__ = [
     "ModelSetup",
     "ModelsStudy",
     "ParameterMap",
+    "PositiveInterval",
     "catalog_entry",
     "discover_models",
     "register_model",
@@ -123,7 +124,9 @@ class ParameterMap:
 
     ``parameters`` are the family's names, ``defaults`` its values (every parameter a study does not
     design keeps its default); ``aliases`` map readable names to parameters (designable too);
-    ``transform`` maps the ``derived`` variables (designed together) to parameters with their derivatives.
+    ``transform`` maps the ``derived`` variables (designed together) to parameters with their derivatives;
+    ``limits`` gives the physical parameters (by parameter or derived name) their least value and what they are
+    (``{"K2": (0.0, "stiffness")}``): design bounds below it are refused (:meth:`check_variables`).
     """
 
     parameters: tuple[str, ...]
@@ -131,11 +134,42 @@ class ParameterMap:
     aliases: dict[str, str] = field(default_factory=dict)
     transform: Transform | None = None
     derived: tuple[str, ...] = ()
+    limits: dict[str, tuple[float, str]] = field(default_factory=dict)
 
     @property
     def designable(self) -> tuple[str, ...]:
         """Names a study may use as design variables."""
         return self.parameters + self.derived + tuple(a for a, k in self.aliases.items() if k in self.parameters)
+
+    def lower_limit(self, name: str) -> tuple[float, str] | None:
+        """(least physical value, what the parameter is) of a design variable (id, alias or derived), or None
+        when the parameter may take any sign."""
+        return self.limits.get(name) or self.limits.get(self.aliases.get(name, name))
+
+    def check_bounds(self, name: str, lower: float, upper: float, where: str) -> None:
+        """Refuse bounds that let a physical parameter (a stiffness, damping, mass, inertia) go below its least
+        value: ``ValueError`` naming ``<where>.lower`` (``upper`` > ``lower`` is the config's own rule)."""
+        limit = self.lower_limit(name)
+        if limit is None or lower >= limit[0]:
+            return
+        least, what = limit
+        key = self.aliases.get(name, name)
+        label = name if key == name else f"{name} ({key})"
+        raise ValueError(f"{where}.lower: {label} is a {what} and cannot be below {least:g}; got {lower:g}")
+
+    def check_variables(self, variables: Sequence[Any], where: str = "design.variables") -> None:
+        """:meth:`check_bounds` of each variable (objects with ``name``, ``lower``, ``upper``), naming
+        ``<where>[i].lower``."""
+        for i, v in enumerate(variables):
+            self.check_bounds(v.name, v.lower, v.upper, f"{where}[{i}]")
+
+    def check_values(self, values: Mapping[str, float], where: str) -> None:
+        """Refuse a design ``{variable: value}`` that puts a physical parameter below its least value, naming
+        ``<where>.<variable>``."""
+        for name, value in values.items():
+            limit = self.lower_limit(name)
+            if limit is not None and not value >= limit[0]:
+                raise ValueError(f"{where}.{name}: a {limit[1]} cannot be below {limit[0]:g}, got {value:g}")
 
     def __call__(self, names: Sequence[str], x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Parameter vector p (P,) for design values ``x`` of ``names``, and dp/dx (P, d)."""
@@ -241,6 +275,16 @@ def discover_models() -> dict[str, CatalogEntry]:
     return MODELS
 
 
+def _positive_lower(v: tuple[float, float]) -> tuple[float, float]:
+    if not v[0] > 0:
+        raise ValueError(f"lower end must be > 0, got {v[0]}")
+    return v
+
+
+PositiveInterval = Annotated[Interval, AfterValidator(_positive_lower)]
+"""A (lower, upper) pair with 0 < lower < upper, both finite: speed ranges (m/s, mph) in options and configs."""
+
+
 def catalog_entry(name: str, field_name: str = "model") -> CatalogEntry:
     models = discover_models()
     if name not in models:
@@ -264,8 +308,9 @@ class ModelRef(StrictModel):
 
     def setup(self, where: str = "models") -> ModelSetup:
         entry = catalog_entry(self.model, f"{where}.model")
+        options = self.validated_options(where)  # its errors name the field already
         try:
-            return entry.build(self.validated_options(where))
+            return entry.build(options)
         except ValueError as exc:
             raise ValueError(f"{where}.options: {exc}") from None
 

@@ -15,7 +15,7 @@ from pydantic import Field
 
 from railopt.models.units import INCH, MPH
 from railopt.models.vehicle.cab import CabInput, cab_lateral_model
-from railopt.studies.catalog import ModelSetup, register_model
+from railopt.studies.catalog import ModelSetup, PositiveInterval, register_model
 from railopt.studies.catalog.vehicle import load, vehicle_setup
 from railopt.studies.config import StrictModel
 
@@ -30,7 +30,7 @@ class CabOptions(StrictModel):
     mode: Literal["fixed_wavelength", "fixed_speed"] = "fixed_wavelength"
     max_operating_speed_mph: float = Field(70.0, gt=0, lt=1000, allow_inf_nan=False,
                                            description="the hunting check requires stability up to this speed")
-    critical_search_mph: tuple[float, float] = Field((2.0, 300.0), description="critical-speed search range")
+    critical_search_mph: PositiveInterval = Field((2.0, 300.0), description="critical-speed search range, mph")
     parameters: dict[str, float] = Field(default_factory=dict, description="values overriding the vehicle file")
 
 
@@ -42,7 +42,6 @@ def cab_lateral_setup(options: CabOptions) -> ModelSetup:
     cab = cab_lateral_model(vehicle, CabInput(options.amplitude_in * INCH, options.max_frequency_hz,
                                               options.max_speed_mph * MPH, options.mode))
     family = cab.system.with_values(cab.parameters())
-    aliases = {a: k for a, k in vehicle.element_aliases().items() if k in family.parameters}
     if options.mode == "fixed_wavelength":
         description = (f"{vehicle.name} cab model, ±{options.amplitude_in:g} in lateral irregularity, "
                        f"λ = {cab.cab_input.wavelength_m:.2f} m")
@@ -50,4 +49,4 @@ def cab_lateral_setup(options: CabOptions) -> ModelSetup:
         description = f"{vehicle.name} cab model, S = {options.max_speed_mph:g} mph"
     search = (options.critical_search_mph[0] * MPH, options.critical_search_mph[1] * MPH)
     return vehicle_setup(vehicle, family, description, ("rigid", "flexible"), search,
-                         options.max_operating_speed_mph * MPH, abscissa=family, aliases=aliases)
+                         options.max_operating_speed_mph * MPH, abscissa=family)

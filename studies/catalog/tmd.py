@@ -38,7 +38,10 @@ def tmd_setup(options: TMDOptions) -> ModelSetup:
     return ModelSetup(
         family=family,
         parameter_map=ParameterMap(tuple(family.parameters), family.values, transform=transform,
-                                   derived=("tuning", "damping_ratio")),
+                                   derived=("tuning", "damping_ratio"),
+                                   limits={"k2": (0.0, "stiffness"), "c2": (0.0, "damping coefficient"),
+                                           "tuning": (0.0, "frequency ratio"),
+                                           "damping_ratio": (0.0, "damping ratio")}),
         named_designs={
             "den_hartog": {"tuning": dh.tuning, "damping_ratio": dh.damping_ratio},
             "nishihara_asami": {"tuning": na.tuning, "damping_ratio": na.damping_ratio},

@@ -15,8 +15,15 @@ from pydantic import Field
 
 from railopt.models import ParametricSystem
 from railopt.models.vehicle import load_vehicle
-from railopt.studies.catalog import AbscissaCheck, HuntingCheck, ModelSetup, ParameterMap, register_model
-from railopt.studies.config import Interval, StrictModel
+from railopt.studies.catalog import (
+    AbscissaCheck,
+    HuntingCheck,
+    ModelSetup,
+    ParameterMap,
+    PositiveInterval,
+    register_model,
+)
+from railopt.studies.config import StrictModel
 
 __all__ = [
     "IrregularityOptions",
@@ -24,6 +31,8 @@ __all__ = [
     "VehicleOptions",
     "lateral_family",
     "load",
+    "physical_limits",
+    "readable_aliases",
     "vehicle_forced_model",
     "vehicle_setup",
 ]
@@ -39,6 +48,39 @@ def lateral_family(vehicle, track: str, names: Sequence[str]) -> ParametricSyste
     """The vehicle's unforced lateral family on ``track`` in those of ``names`` that act laterally."""
     view = vehicle.lateral(track=track)
     return view.family([n for n in names if n in view.parts or n in view.aliases])
+
+
+PHYSICAL = {"spring": "stiffness", "damper": "damping coefficient", "rotational_spring": "rotational stiffness",
+            "rotational_damper": "rotational damping coefficient"}
+"""What an element's value is, by element type: each is ≥ 0."""
+
+
+def physical_limits(vehicle, names: Sequence[str]) -> dict[str, tuple[float, str]]:
+    """name -> (0, what it is) for every element id, body mass (``<body>.mass``) and inertia
+    (``<body>.Ixx|Iyy|Izz``) among ``names``: physical values that cannot go below zero."""
+    kinds = {e.id: PHYSICAL.get(e.type, "suspension value") for e in vehicle.elements}
+    bodies = {b.name for b in vehicle.bodies}
+    out = {}
+    for n in names:
+        body, _, attr = n.rpartition(".")
+        if n in kinds:
+            out[n] = (0.0, kinds[n])
+        elif body in bodies and attr == "mass":
+            out[n] = (0.0, "mass")
+        elif body in bodies and attr in ("Ixx", "Iyy", "Izz"):
+            out[n] = (0.0, "moment of inertia")
+    return out
+
+
+def readable_aliases(vehicle, names: Sequence[str]) -> dict[str, str]:
+    """alias -> parameter for the element aliases and the file's own aliases that name one of ``names``."""
+    elements = vehicle.element_aliases()
+    out = {a: k for a, k in elements.items() if k in names}
+    for a, target in vehicle.aliases.items():
+        key = elements.get(target, target)
+        if key in names and a not in names:
+            out[a] = key
+    return out
 
 
 def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: Sequence[str],
@@ -65,10 +107,11 @@ def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: S
         The unforced family whose spectral abscissa (at its speed) is the ``spectral_abscissa`` check;
         default: the first stability family at ``family``'s speed.
     aliases : mapping alias -> id, optional
-        Readable names, designable and set in the existing design too.
+        Readable names, designable and set in the existing design too; default: every alias of the vehicle
+        (element aliases and the file's aliases) that names a parameter of ``family``.
     """
     names = tuple(family.parameters)
-    aliases = dict(aliases or {})
+    aliases = readable_aliases(vehicle, names) if aliases is None else dict(aliases)
     stability = {track: lateral_family(vehicle, track, names) for track in tracks}
     if abscissa is None:
         abscissa = stability[tracks[0]].with_values(stability[tracks[0]].values, speed=family.speed)
@@ -76,7 +119,7 @@ def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: S
     existing |= {a: float(existing[k]) for a, k in aliases.items()}
     return ModelSetup(
         family=family,
-        parameter_map=ParameterMap(names, family.values, aliases),
+        parameter_map=ParameterMap(names, family.values, aliases, limits=physical_limits(vehicle, names)),
         named_designs={"existing": existing},
         checks={"spectral_abscissa": AbscissaCheck(abscissa),
                 "hunting": HuntingCheck(stability, names, search, max_speed)},
@@ -93,7 +136,8 @@ class HuntingOptions(StrictModel):
     max_operating_speed_m_s: float | None = Field(
         None, gt=0, lt=1000, allow_inf_nan=False,
         description="the hunting check requires stability up to this speed (default: speed_m_s)")
-    critical_search_m_s: Interval = Field((1.0, 150.0), description="critical-speed search range of the hunting check")
+    critical_search_m_s: PositiveInterval = Field((1.0, 150.0),
+                                                  description="critical-speed search range of the hunting check, m/s")
 
     def hunting(self, speed: float) -> tuple[tuple[float, float], float]:
         """(search range, maximum operating speed), m/s."""

@@ -48,6 +48,7 @@ class DesignSpec(FiniteModel):
         bad = [k for k in self.values if k not in setup.designable]
         if bad:
             raise ValueError(f"{where}.values: {bad} are not parameters; choose from {list(setup.designable)}")
+        setup.parameter_map.check_values(self.values, f"{where}.values")
         return dict(self.values)
 
 
