@@ -11,9 +11,9 @@ from typing import Any
 import numpy as np
 
 from railopt.design.methods import METHODS
-from railopt.design.methods.base import COMMON_OPTIONS, EpigraphView, StopSolve
+from railopt.design.methods.base import COMMON_OPTIONS, EpigraphView, Outcome, StopSolve
 from railopt.design.problem import Evaluation, MinimaxProblem
-from railopt.design.result import SolveResult
+from railopt.design.result import SUCCESS_STATUSES, SolveResult
 
 
 def method_options(method: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -65,7 +65,15 @@ def solve(problem: MinimaxProblem, x0: Sequence[float], method: str = "slsqp", *
         view = EpigraphView(problem, x0, opts)
     except StopSolve as stop:  # the model fails at the start point itself
         return _result(problem, x0, x0, None, np.inf, stop.status, stop.message, 0, start, method)
-    outcome = METHODS[method].run(view, problem.space.to_u(x0), opts)
+    try:
+        outcome = METHODS[method].run(view, problem.space.to_u(x0), opts)
+    except StopSolve as stop:
+        outcome = Outcome(problem.space.to_u(view.best_x), view.best_merit, stop.status, stop.message)
+    except Exception as exc:  # anything else a method lets through: a status with the best point, never a raise
+        outcome = Outcome(problem.space.to_u(view.best_x), view.best_merit, "failure",
+                          f"{method} raised {type(exc).__name__}: {exc}")
+    if outcome.status not in SUCCESS_STATUSES and view.gradient_note:  # say why a solver may have failed
+        outcome = Outcome(outcome.u, outcome.tau, outcome.status, f"{outcome.message}; {view.gradient_note}")
     # re-evaluate ourselves: the solver's point, or the best point it evaluated if that is better
     x_solver = problem.space.to_x(np.clip(outcome.u, 0.0, 1.0))
     evaluated = [(x_solver, _safe_evaluate(problem, x_solver))]
