@@ -15,9 +15,18 @@ from railopt.design.methods.base import COMMON_OPTIONS, EpigraphView, Outcome, S
 from railopt.design.problem import Evaluation, MinimaxProblem
 from railopt.design.result import SUCCESS_STATUSES, SolveResult
 
+MAX_EVAL = 2**31 - 1  # NLopt's set_maxeval takes a C int
+
 
 def method_options(method: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Merge defaults and user options; unknown methods or option names raise naming the field."""
+    """Merge defaults and user options; unknown methods or option names raise naming the field.
+
+    Raises
+    ------
+    ValueError
+        Naming ``method`` or ``options.<name>``: an unknown method or option, a tolerance or time
+        that is not a positive finite number, or ``maxeval`` not an integer in [1, 2**31 − 1].
+    """
     if method not in METHODS:
         raise ValueError(f"method: unknown method {method!r}; registered: {sorted(METHODS)}")
     spec = METHODS[method]
@@ -26,7 +35,7 @@ def method_options(method: str, options: dict[str, Any] | None = None) -> dict[s
         if key not in merged:
             raise ValueError(f"options.{key}: unknown option for method {method!r}; known: {sorted(merged)}")
         merged[key] = value
-    for key in ("xtol", "ftol", "maxtime"):
+    for key in ("xtol", "ftol", "maxtime", *(k for k in ("initial_step", "initial_radius", "penalty") if k in merged)):
         value = merged[key]
         if isinstance(value, bool) or not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
             raise ValueError(f"options.{key}: must be a positive number, got {value!r}")
@@ -34,6 +43,9 @@ def method_options(method: str, options: dict[str, Any] | None = None) -> dict[s
     value = merged["maxeval"]
     if isinstance(value, bool) or not (isinstance(value, numbers.Integral) and value > 0):
         raise ValueError(f"options.maxeval: must be a positive integer, got {value!r}")
+    if value > MAX_EVAL:
+        raise ValueError(f"options.maxeval: {value} is more than NLopt accepts (a C int: at most 2**31 - 1 = "
+                         f"{MAX_EVAL})")
     merged["maxeval"] = int(value)
     return merged
 
