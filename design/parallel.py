@@ -273,10 +273,12 @@ def _workers(client: Any) -> dict:
 
 
 def _lost(info: _ClientInfo, exc: BaseException | None) -> SchedulerError:
-    detail = f" ({' '.join(f'{type(exc).__name__}: {exc}'.split())[:200]})" if exc is not None else ""
+    # dask's own text (e.g. "in <TCP (closed) ConnectionPool.gather ... remote=<a worker>>") would name a
+    # worker or a pool, not the scheduler: it is kept as the exception's __cause__ only
     where = f"{info.address!r}" if info.external else f"the local dask cluster at {info.address}"
-    return SchedulerError(f"scheduler: lost the connection to {where}{detail}; finished starts are kept, "
-                          "rerun with --resume")
+    error = SchedulerError(f"scheduler: lost the connection to {where}; finished starts are kept, rerun with --resume")
+    error.__cause__ = exc
+    return error
 
 
 def _no_workers(info: _ClientInfo, waited: float, resume: bool) -> str:
@@ -437,11 +439,14 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     from dask.distributed import Client, LocalCluster
 
     wait = scheduler_timeout(timeout) if timeout is not None else max(scheduler_timeout(), 30.0)
-    # a start that kills its worker is tried twice, not four times, before it is reported as lost
+    # A start that kills its worker is tried twice, not four times, before it is reported as lost; each worker
+    # holds one task at a time (worker-saturation 1), so a death is held against the task that caused it only.
     with (
         _quiet_dask_logs(),
-        dask.config.set({"distributed.scheduler.allowed-failures": 1}),
+        dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0}),
         LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                     # the scheduler's HTTP routes on a free local port, not 8787 (taken: a warning on stderr)
+                     scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                      silence_logs=logging.ERROR, preload=[_WORKER_PRELOAD]) as cluster,
         Client(cluster) as client,
     ):
