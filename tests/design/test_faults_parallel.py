@@ -289,3 +289,45 @@ def test_a_lost_scheduler_is_one_error_and_the_finished_starts_are_kept(schedule
     np.testing.assert_allclose(table["value"].min(), U_STAR, atol=1e-7)
     again = table.set_index("start_id").loc[kept["start_id"]]
     np.testing.assert_array_equal(again["value"], kept["value"].to_numpy())
+
+
+CTRL_C = """
+import sys, time
+from railopt.design.parallel import dask_client, map_unordered
+
+
+def slow(i):
+    time.sleep(0.2)
+    return i
+
+
+if __name__ == "__main__":
+    try:
+        with dask_client(workers=2) as client:
+            print("pids", *client.run(lambda: __import__("os").getpid()).values(), flush=True)
+            for i in map_unordered(slow, range(10_000), client=client):
+                if i == 3:
+                    print("running", flush=True)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        sys.exit(130)
+"""
+
+
+@pytest.mark.timeout(120)
+def test_ctrl_c_to_the_process_group_prints_no_worker_traceback(tmp_path: Path) -> None:
+    """SIGINT to the whole group (what Ctrl-C in a terminal does): the workers ignore it, dask says nothing."""
+    script = tmp_path / "ctrl_c.py"
+    script.write_text(CTRL_C)
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    pids = [int(p) for p in proc.stdout.readline().split()[1:]]
+    assert len(pids) == 2
+    assert proc.stdout.readline().strip() == "running"
+    os.killpg(proc.pid, signal.SIGINT)  # the group this test started
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.strip() == "interrupted", err  # no "Traceback", no "KeyboardInterrupt", no dask WARNING lines
+    for pid in pids:  # the workers were shut down by the main process, not killed by the signal
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
