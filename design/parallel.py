@@ -30,6 +30,7 @@ import logging
 import math
 import numbers
 import os
+import queue
 import threading
 import time
 import weakref
@@ -67,8 +68,11 @@ class SchedulerError(ConnectionError):
     """The dask scheduler cannot be used (unreachable, not a scheduler, no workers, lost); the message names it."""
 
 
-class WorkerLost(RuntimeError):
-    """A task killed every worker that ran it (``distributed.KilledWorker``); names the task and the last worker."""
+class WorkerLost(ChildProcessError):
+    """A task killed every worker that ran it (``distributed.KilledWorker``); names the last worker.
+
+    An ``OSError`` (a child process failed), so that a command line reports it as one line.
+    """
 
     def __init__(self, message: str, worker: str | None = None) -> None:
         super().__init__(message)
@@ -191,7 +195,7 @@ def map_unordered(
         return
     check_picklable(fn, getattr(fn, "__name__", "function"))
     check_picklable(items[0])  # the tasks of one map share their problem and functions: the first tells
-    from distributed import wait
+    from distributed import as_completed
 
     info = _CLIENTS.get(client) or _ClientInfo(_address(client), scheduler_timeout(), True)
     try:
@@ -199,35 +203,46 @@ def map_unordered(
     except Exception as exc:  # e.g. the connection is gone already
         raise _lost(info, exc) from None
     item_of = {f.key: it for f, it in zip(futures, items, strict=True)}
-    pending = set(futures)
+    # as_completed blocks without a timeout: it runs in a thread, and this one watches the scheduler meanwhile
+    finished: queue.Queue = queue.Queue()
+
+    def pump() -> None:
+        try:
+            for future in as_completed(futures):
+                finished.put(future)
+        except Exception as exc:  # noqa: BLE001  (the client broke down: reported below)
+            finished.put(exc)
+        finally:
+            finished.put(None)
+
+    threading.Thread(target=pump, name="railopt-as-completed", daemon=True).start()
+    remaining = len(futures)
     no_workers_since: float | None = None
     unhealthy_since: float | None = None
     try:
-        while pending:
+        while remaining:
             try:
-                done, pending = wait(pending, timeout=_POLL, return_when="FIRST_COMPLETED")
-            except TimeoutError:
-                done = set()
-            except Exception as exc:  # the client broke down while waiting
-                raise _lost(info, exc) from None
-            for future in sorted(done, key=lambda f: futures.index(f)):
-                yield _result(future, item_of[future.key], info, on_lost)
-            if done:
-                no_workers_since = unhealthy_since = None
+                got = finished.get(timeout=_POLL)
+            except queue.Empty:
+                now = time.monotonic()
+                if client.status != "running":
+                    unhealthy_since = unhealthy_since or now
+                    if now - unhealthy_since > info.timeout:
+                        raise _lost(info, None) from None
+                    continue
+                unhealthy_since = None
+                if not _workers(client):
+                    no_workers_since = no_workers_since or now
+                    if now - no_workers_since > info.timeout:
+                        raise SchedulerError(_no_workers(info, now - no_workers_since, resume=True)) from None
+                else:
+                    no_workers_since = None
                 continue
-            now = time.monotonic()
-            if client.status != "running":
-                unhealthy_since = unhealthy_since or now
-                if now - unhealthy_since > info.timeout:
-                    raise _lost(info, None)
-                continue
-            unhealthy_since = None
-            if not _workers(client):
-                no_workers_since = no_workers_since or now
-                if now - no_workers_since > info.timeout:
-                    raise SchedulerError(_no_workers(info, now - no_workers_since, resume=True))
-            else:
-                no_workers_since = None
+            if got is None or isinstance(got, Exception):  # the stream of results ended early
+                raise _lost(info, got if isinstance(got, Exception) else None)
+            remaining -= 1
+            no_workers_since = unhealthy_since = None
+            yield _result(got, item_of[got.key], info, on_lost)
     finally:
         for future in futures:  # interrupted: do not leave work queued on a shared cluster
             if not future.done():
@@ -438,7 +453,10 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     import dask
     from dask.distributed import Client, LocalCluster
 
-    wait = scheduler_timeout(timeout) if timeout is not None else max(scheduler_timeout(), 30.0)
+    try:  # how long the embedded cluster may be without workers (restarting after a crash) before giving up
+        wait = max(scheduler_timeout(timeout), 30.0)
+    except ValueError:  # a bad $RAILOPT_SCHEDULER_TIMEOUT matters only for a scheduler address
+        wait = 30.0
     # A start that kills its worker is tried twice, not four times, before it is reported as lost; each worker
     # holds one task at a time (worker-saturation 1), so a death is held against the task that caused it only.
     with (
