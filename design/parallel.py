@@ -386,7 +386,8 @@ def _connect(scheduler: str, wait: float) -> Any:
         raise SchedulerError(f"scheduler: {scheduler!r} is not a valid address ({exc}); {hint}")
     if isinstance(exc, OSError):
         raise SchedulerError(f"scheduler: cannot connect to {scheduler!r} within {wait:g} s ({exc}); {hint}")
-    # dask read something that is not its protocol (an HTTP server: "HTTP/1.0" taken as a frame length)
+    if isinstance(exc, MemoryError):  # dask took the first bytes of another protocol ("HTTP/1.0") as a frame length
+        text = "its reply is not dask's protocol: an HTTP server, e.g. a dashboard port?"
     raise SchedulerError(f"scheduler: {scheduler!r} did not answer as a dask scheduler ({text}); {hint}")
 
 
