@@ -37,6 +37,7 @@ import weakref
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, fields, is_dataclass
+from pathlib import Path
 from typing import Any
 
 from threadpoolctl import threadpool_limits
@@ -47,7 +48,12 @@ DASK_LOGS_ENV = "RAILOPT_DASK_LOGS"
 DEFAULT_SCHEDULER_TIMEOUT = 5.0
 SCHEDULER_MARGIN = 5.0  # s beyond the scheduler timeout that giving up on a silent or dead scheduler may take
 _POLL = 0.25  # s between checks of the scheduler's health while waiting for results
-_WORKER_PRELOAD = "railopt.design._worker_setup"
+LOCAL_NO_WORKERS_LIMIT = 120.0  # s the embedded LocalCluster may have no worker (restarting) before an error
+
+
+def _worker_setup_source() -> str:
+    """The worker preload as source text: a restarted worker registers without importing railopt first."""
+    return (Path(__file__).with_name("_worker_setup.py")).read_text()
 
 
 @dataclass(frozen=True)
@@ -230,8 +236,14 @@ def map_unordered(
                     if now - unhealthy_since > info.timeout:
                         raise _lost(info, None) from None
                     continue
+                workers = _workers(client, info.timeout)
+                if workers is None:  # no answer: counted as a connection in trouble
+                    unhealthy_since = unhealthy_since or now
+                    if time.monotonic() - unhealthy_since > info.timeout:
+                        raise _lost(info, None) from None
+                    continue
                 unhealthy_since = None
-                if not _workers(client):
+                if not workers:
                     no_workers_since = no_workers_since or now
                     if now - no_workers_since > info.timeout:
                         raise SchedulerError(_no_workers(info, now - no_workers_since, resume=True)) from None
@@ -280,11 +292,13 @@ def _address(client: Any) -> str:
         return "the dask scheduler"
 
 
-def _workers(client: Any) -> dict:
+def _workers(client: Any, timeout: float) -> dict | None:
+    """The scheduler's workers, asked now (bounded in time); None when the scheduler does not answer."""
     try:
-        return client.scheduler_info().get("workers", {})
+        identity = client.sync(client.scheduler.identity, n_workers=-1, callback_timeout=timeout)
+        return dict(identity.get("workers", {}))
     except Exception:
-        return {}
+        return None
 
 
 def _lost(info: _ClientInfo, exc: BaseException | None) -> SchedulerError:
@@ -440,7 +454,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
                 try:
                     client.wait_for_workers(1, timeout=wait)
                 except Exception:  # TimeoutError, or the scheduler went away meanwhile
-                    if client.status == "running" and not _workers(client):
+                    if client.status == "running" and _workers(client, wait) == {}:
                         raise SchedulerError(_no_workers(info, wait, resume=False)) from None
                     if client.status != "running":
                         raise _lost(info, None) from None
@@ -454,10 +468,8 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     import dask
     from dask.distributed import Client, LocalCluster
 
-    try:  # how long the embedded cluster may be without workers (restarting after a crash) before giving up
-        wait = max(scheduler_timeout(timeout), 30.0)
-    except ValueError:  # a bad $RAILOPT_SCHEDULER_TIMEOUT matters only for a scheduler address
-        wait = 30.0
+    # how long the embedded cluster may be without workers (its nannies restart crashed ones) before giving up
+    wait = LOCAL_NO_WORKERS_LIMIT
     # A start that kills its worker is tried twice, not four times, before it is reported as lost; each worker
     # holds one task at a time (worker-saturation 1), so a death is held against the task that caused it only.
     with (
@@ -466,7 +478,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                      # the scheduler's HTTP routes on a free local port, not 8787 (taken: a warning on stderr)
                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                     silence_logs=logging.ERROR, preload=[_WORKER_PRELOAD]) as cluster,
+                     silence_logs=logging.ERROR, preload=[_worker_setup_source()]) as cluster,
         Client(cluster) as client,
     ):
         _CLIENTS[client] = _ClientInfo(str(cluster.scheduler_address), wait, False)
