@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import call, map_unordered
+from railopt.design.parallel import WorkerLost, call, map_unordered
 from railopt.design.problem import MinimaxProblem
 from railopt.design.result import SolveResult
 from railopt.design.solve import method_options, solve
@@ -30,6 +30,15 @@ class _StartTask:
         return self.start, solve(self.problem, self.start.x0, method=self.method, **self.options)
 
 
+def _lost_start(task: _StartTask, lost: WorkerLost) -> tuple[Start, SolveResult]:
+    """The row of a start whose task killed every worker it ran on: x = x0, U = inf, status ``worker_lost``."""
+    x0 = np.asarray(task.start.x0, dtype=float)
+    return task.start, SolveResult(
+        x=x0, value=np.inf, t=np.inf, status="worker_lost",
+        message=f"worker lost: {lost}; not retried on --resume unless asked (retry_failed)",
+        evaluations=0, wall_time=0.0, method=task.method, x0=x0, constraint_violation=0.0, bound_violation=0.0,
+    )
+
 
 def multistart(
     problem: MinimaxProblem,
@@ -43,6 +52,7 @@ def multistart(
     options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
     cluster_xtol: float = 1e-3,
+    retry_failed: bool = False,
 ) -> pd.DataFrame:
     """Solve from user ``points`` plus ``n_starts`` quasi-random starts; one row per start.
 
@@ -68,6 +78,20 @@ def multistart(
         Called after every finished start.
     cluster_xtol : float
         Distance (∞-norm in unit-cube coordinates) under which optima count as the same.
+    retry_failed : bool
+        Re-run the stored starts whose task killed every worker it ran on (status ``worker_lost``);
+        by default a resume skips them, as it skips every finished start.
+
+    A start whose task kills every dask worker that runs it (a crash in native code, out of memory)
+    is stored with status ``worker_lost`` and the campaign goes on with the others.
+
+    Raises
+    ------
+    ValueError
+        Before any work: a bad method, option, seed, ``n_starts`` or point (naming the field), or a
+        problem that cannot be sent to dask workers (naming what does not pickle).
+    railopt.design.parallel.SchedulerError
+        The dask scheduler was lost or has no workers; the finished starts are in the store.
 
     Returns
     -------
@@ -82,14 +106,14 @@ def multistart(
     if owned:
         store = CampaignStore.in_memory(problem.space.names)
     try:
-        done_ids = store.finished_ids()
+        done_ids = store.finished_ids(retry_failed=bool(retry_failed))
         todo = [s for s in starts if s.start_id not in done_ids]
         total, done = len(starts), len(starts) - len(todo)
         if progress is not None:
             progress(done, total)
         user_options = dict(options or {})
         tasks = [_StartTask(problem, s, method, user_options) for s in todo]
-        for start, result in map_unordered(call, tasks, client=client):
+        for start, result in map_unordered(call, tasks, client=client, on_lost=_lost_start):
             store.add_start(start.start_id, start.origin, seed, result)
             done += 1
             if progress is not None:

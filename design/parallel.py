@@ -1,27 +1,59 @@
 """Where tasks run: in-process, or on dask.distributed (an embedded LocalCluster or a scheduler).
 
 The design layer takes an optional ``client``; with none, the same code runs serially.
-Results stream back in completion order (``as_completed``); a lost worker's tasks are retried.
+Results stream back in completion order; a lost worker's tasks are retried by the scheduler.
 Every task runs with single-threaded BLAS: parallelism is across tasks, small matrices gain
 nothing from threads, and a threaded BLAS rounds differently — with it, a serial run and a
 dask run of the same campaign would not give the same table.
+
+Failures the dask paths turn into one clear exception (never a dask traceback, never a hang):
+
+* a task that cannot be pickled: ``ValueError`` naming what cannot be sent (e.g. ``problem.functions``),
+  raised before anything is submitted (:func:`check_picklable`);
+* a task that kills every worker it runs on (a crash in native code, out of memory): with ``on_lost``
+  the task's result is made by ``on_lost(item, exc)`` (``multistart`` stores the start as
+  ``worker_lost``) and the other tasks go on; without it :class:`WorkerLost` is raised;
+* a scheduler address that is not a dask scheduler, that never answers, that has no workers, or that
+  goes away during the run: :class:`SchedulerError` (a ``ConnectionError``) naming the address and the
+  way out, within the scheduler timeout plus :data:`SCHEDULER_MARGIN` seconds.
+
+Logs.  While a client made by :func:`dask_client` is open, dask's own log lines (warnings about
+restarted workers, cancelled instructions at shutdown) are kept out of the terminal: set
+``$RAILOPT_DASK_LOGS`` to a level name (e.g. ``WARNING``) to see them.  The workers of the embedded
+LocalCluster ignore SIGINT: Ctrl-C in a terminal (SIGINT to the whole process group) interrupts the
+main process only, which shuts the cluster down.
 """
 
 from __future__ import annotations
 
+import logging
 import math
 import numbers
 import os
+import queue
+import threading
+import time
+import weakref
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, is_dataclass
+from pathlib import Path
 from typing import Any
 
 from threadpoolctl import threadpool_limits
 
 SCHEDULER_ENV = "RAILOPT_SCHEDULER"
 SCHEDULER_TIMEOUT_ENV = "RAILOPT_SCHEDULER_TIMEOUT"
+DASK_LOGS_ENV = "RAILOPT_DASK_LOGS"
 DEFAULT_SCHEDULER_TIMEOUT = 5.0
+SCHEDULER_MARGIN = 5.0  # s beyond the scheduler timeout that giving up on a silent or dead scheduler may take
+_POLL = 0.25  # s between checks of the scheduler's health while waiting for results
+LOCAL_NO_WORKERS_LIMIT = 120.0  # s the embedded LocalCluster may have no worker (restarting) before an error
+
+
+def _worker_setup_source() -> str:
+    """The worker preload as source text: a restarted worker registers without importing railopt first."""
+    return (Path(__file__).with_name("_worker_setup.py")).read_text()
 
 
 @dataclass(frozen=True)
@@ -38,32 +70,254 @@ def call(task: Callable[[], Any]) -> Any:
     return task()
 
 
+class SchedulerError(ConnectionError):
+    """The dask scheduler cannot be used (unreachable, not a scheduler, no workers, lost); the message names it."""
+
+
+class WorkerLost(ChildProcessError):
+    """A task killed every worker that ran it (``distributed.KilledWorker``); names the last worker.
+
+    An ``OSError`` (a child process failed), so that a command line reports it as one line.
+    """
+
+    def __init__(self, message: str, worker: str | None = None) -> None:
+        super().__init__(message)
+        self.worker = worker
+
+
+@dataclass(frozen=True)
+class _ClientInfo:
+    address: str
+    timeout: float
+    external: bool
+
+
+_CLIENTS: weakref.WeakKeyDictionary[Any, _ClientInfo] = weakref.WeakKeyDictionary()
+
+
+# ---------------------------------------------------------------------- pickling
+def _pickle_error(obj: Any) -> Exception | None:
+    import cloudpickle
+
+    try:
+        cloudpickle.dumps(obj)
+    except Exception as exc:  # any failure to serialise (TypeError, PicklingError, AttributeError, ...)
+        return exc
+    return None
+
+
+def _parts(obj: Any) -> list[tuple[str, Any]]:
+    """Named parts of an object to look into for the one that does not pickle."""
+    if is_dataclass(obj) and not isinstance(obj, type):
+        return [(f.name, getattr(obj, f.name, None)) for f in fields(obj)]
+    if callable(obj) and getattr(obj, "__closure__", None):
+        names = obj.__code__.co_freevars
+        return [(n, c.cell_contents) for n, c in zip(names, obj.__closure__, strict=False) if _has_contents(c)]
+    if isinstance(obj, dict):
+        return [(repr(k), v) for k, v in obj.items()]
+    if isinstance(obj, list | tuple):
+        return [(f"[{i}]", v) for i, v in enumerate(obj)]
+    if hasattr(obj, "__dict__") and not isinstance(obj, type):
+        return [(k.lstrip("_"), v) for k, v in vars(obj).items()]
+    return []
+
+
+def _has_contents(cell: Any) -> bool:
+    try:
+        cell.cell_contents  # noqa: B018
+    except ValueError:
+        return False
+    return True
+
+
+def _find_unpicklable(obj: Any, path: str, depth: int = 0) -> tuple[str, Exception] | None:
+    exc = _pickle_error(obj)
+    if exc is None:
+        return None
+    if depth < 6:
+        for name, part in _parts(obj):
+            sep = "" if name.startswith("[") or not path else "."
+            found = _find_unpicklable(part, f"{path}{sep}{name}", depth + 1)
+            if found is not None:
+                return found
+    return path or type(obj).__name__, exc
+
+
+def check_picklable(obj: Any, name: str = "") -> None:
+    """Raise ``ValueError`` naming the part of ``obj`` that cannot be sent to dask workers.
+
+    ``name`` prefixes the path (empty: paths start at ``obj``'s fields, e.g. ``problem.functions``).
+
+    The message names the innermost attribute, field or closure variable that does not pickle, e.g.
+    ``problem.functions.lock: cannot be sent to dask workers (TypeError: cannot pickle '_thread.lock'
+    object); define it at module level or use workers=0``.
+    """
+    found = _find_unpicklable(obj, name)
+    if found is not None:
+        path, exc = found
+        text = " ".join(f"{type(exc).__name__}: {exc}".split())
+        raise ValueError(f"{path}: cannot be sent to dask workers ({text[:300]}); define it at module level "
+                         "(without open files, locks or connections) or use workers=0 (serial)")
+
+
+# ---------------------------------------------------------------------- mapping
 def map_unordered(
-    fn: Callable[[Any], Any], items: Iterable[Any], client: Any = None, retries: int = 3
+    fn: Callable[[Any], Any],
+    items: Iterable[Any],
+    client: Any = None,
+    retries: int = 3,
+    on_lost: Callable[[Any, WorkerLost], Any] | None = None,
 ) -> Iterator[Any]:
-    """Yield ``fn(item)`` for each item, in completion order; serial when ``client`` is None."""
+    """Yield ``fn(item)`` for each item, in completion order; serial when ``client`` is None.
+
+    Parameters
+    ----------
+    fn : callable
+        Applied to each item (on a worker when ``client`` is given).
+    items : iterable
+    client : dask.distributed.Client, optional
+    retries : int
+        Re-runs of a task that raised (dask's ``retries``); a task whose worker died is re-run by
+        the scheduler (``distributed.scheduler.allowed-failures``).
+    on_lost : callable(item, WorkerLost), optional
+        Makes the result of a task that killed every worker it ran on; ``None``: raise :class:`WorkerLost`.
+
+    Raises
+    ------
+    ValueError
+        Before submitting anything, naming what cannot be pickled (``fn`` or a part of the first item).
+    SchedulerError
+        The scheduler was lost, or had no workers for longer than its timeout; names the address.
+    WorkerLost
+        Without ``on_lost``, for a task that killed its workers.
+    """
     items = list(items)
     task = _SingleThreaded(fn)
     if client is None:
         for item in items:
             yield task(item)
         return
-    from dask.distributed import as_completed
+    if not items:
+        return
+    check_picklable(fn, getattr(fn, "__name__", "function"))
+    check_picklable(items[0])  # the tasks of one map share their problem and functions: the first tells
+    from distributed import as_completed
 
-    futures = client.map(task, items, pure=False, retries=retries)
+    info = _CLIENTS.get(client) or _ClientInfo(_address(client), scheduler_timeout(), True)
     try:
-        for future in as_completed(futures):
-            yield future.result()
+        futures = client.map(task, items, pure=False, retries=retries)
+    except Exception as exc:  # e.g. the connection is gone already
+        raise _lost(info, exc) from None
+    item_of = {f.key: it for f, it in zip(futures, items, strict=True)}
+    # as_completed blocks without a timeout: it runs in a thread, and this one watches the scheduler meanwhile
+    finished: queue.Queue = queue.Queue()
+
+    def pump() -> None:
+        try:
+            for future in as_completed(futures):
+                finished.put(future)
+        except Exception as exc:  # noqa: BLE001  (the client broke down: reported below)
+            finished.put(exc)
+        finally:
+            finished.put(None)
+
+    threading.Thread(target=pump, name="railopt-as-completed", daemon=True).start()
+    remaining = len(futures)
+    no_workers_since: float | None = None
+    unhealthy_since: float | None = None
+    try:
+        while remaining:
+            try:
+                got = finished.get(timeout=_POLL)
+            except queue.Empty:
+                now = time.monotonic()
+                if client.status != "running":
+                    unhealthy_since = unhealthy_since or now
+                    if now - unhealthy_since > info.timeout:
+                        raise _lost(info, None) from None
+                    continue
+                workers = _workers(client, info.timeout)
+                if workers is None:  # no answer: counted as a connection in trouble
+                    unhealthy_since = unhealthy_since or now
+                    if time.monotonic() - unhealthy_since > info.timeout:
+                        raise _lost(info, None) from None
+                    continue
+                unhealthy_since = None
+                if not workers:
+                    no_workers_since = no_workers_since or now
+                    if now - no_workers_since > info.timeout:
+                        raise SchedulerError(_no_workers(info, now - no_workers_since, resume=True)) from None
+                else:
+                    no_workers_since = None
+                continue
+            if got is None or isinstance(got, Exception):  # the stream of results ended early
+                raise _lost(info, got if isinstance(got, Exception) else None)
+            remaining -= 1
+            no_workers_since = unhealthy_since = None
+            yield _result(got, item_of[got.key], info, on_lost)
     finally:
         for future in futures:  # interrupted: do not leave work queued on a shared cluster
             if not future.done():
-                future.cancel()
+                try:
+                    future.cancel()
+                except Exception:  # noqa: S110  (the connection is gone: nothing is queued any more)
+                    pass
 
 
-class SchedulerError(ConnectionError):
-    """The dask scheduler cannot be reached (or its address is not valid); the message names it."""
+def _result(future: Any, item: Any, info: _ClientInfo, on_lost: Callable[[Any, WorkerLost], Any] | None) -> Any:
+    from distributed import KilledWorker
+
+    status = future.status
+    if status == "cancelled":
+        raise _lost(info, None)
+    try:
+        return future.result()
+    except KilledWorker as exc:
+        worker = getattr(getattr(exc, "last_worker", None), "address", None) or str(getattr(exc, "last_worker", ""))
+        lost = WorkerLost(f"the task killed every worker that ran it (last: {worker}; a crash in native code or "
+                          f"out of memory?)", worker)
+        if on_lost is None:
+            raise lost from None
+        return on_lost(item, lost)
+    except Exception as exc:
+        if status == "error":  # the task itself raised: its own exception, as it would serially
+            raise
+        raise _lost(info, exc) from None  # fetching the result failed: the connection
 
 
+def _address(client: Any) -> str:
+    try:
+        return str(client.scheduler.address)
+    except Exception:
+        return "the dask scheduler"
+
+
+def _workers(client: Any, timeout: float) -> dict | None:
+    """The scheduler's workers, asked now (bounded in time); None when the scheduler does not answer."""
+    try:
+        identity = client.sync(client.scheduler.identity, n_workers=-1, callback_timeout=timeout)
+        return dict(identity.get("workers", {}))
+    except Exception:
+        return None
+
+
+def _lost(info: _ClientInfo, exc: BaseException | None) -> SchedulerError:
+    # dask's own text (e.g. "in <TCP (closed) ConnectionPool.gather ... remote=<a worker>>") would name a
+    # worker or a pool, not the scheduler: it is kept as the exception's __cause__ only
+    where = f"{info.address!r}" if info.external else f"the local dask cluster at {info.address}"
+    error = SchedulerError(f"scheduler: lost the connection to {where}; finished starts are kept, rerun with --resume")
+    error.__cause__ = exc
+    return error
+
+
+def _no_workers(info: _ClientInfo, waited: float, resume: bool) -> str:
+    after = "finished starts are kept, rerun with --resume once workers are attached" if resume else (
+        "attach workers (dask worker ADDRESS)")
+    return (f"scheduler: {info.address!r} has no workers (waited {waited:.0f} s); {after}, "
+            "or run on a local cluster with --workers N")
+
+
+# ---------------------------------------------------------------------- clients
 def scheduler_timeout(timeout: float | None = None, field: str = "timeout") -> float:
     """Seconds to wait for a scheduler: ``timeout``, else ``$RAILOPT_SCHEDULER_TIMEOUT``, else 5.
 
@@ -80,6 +334,93 @@ def scheduler_timeout(timeout: float | None = None, field: str = "timeout") -> f
     return float(timeout)
 
 
+class _Below(logging.Filter):
+    def __init__(self, level: int) -> None:
+        super().__init__()
+        self.level = level
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.levelno >= self.level
+
+
+@contextmanager
+def _quiet_dask_logs() -> Iterator[None]:
+    """Keep dask's (and tornado's) log records out of this process's terminal until exit.
+
+    A filter on their stream handlers (it survives LocalCluster's own ``silence_logs`` level changes);
+    ``$RAILOPT_DASK_LOGS`` = a level name lets records of that level and above through.
+    """
+    text = os.environ.get(DASK_LOGS_ENV, "").strip().upper()
+    level = logging.getLevelName(text) if text else logging.CRITICAL + 1
+    if not isinstance(level, int):
+        raise ValueError(f"{DASK_LOGS_ENV}: must be a logging level name (e.g. WARNING), got {text!r}")
+    import distributed  # noqa: F401  (sets up dask's loggers and handlers first)
+
+    quiet = _Below(level)
+    handlers = []
+    for name, logger in list(logging.root.manager.loggerDict.items()):
+        if isinstance(logger, logging.Logger) and name.split(".")[0] in ("distributed", "tornado", "asyncio"):
+            handlers += [h for h in logger.handlers if isinstance(h, logging.StreamHandler)]
+    for handler in handlers:
+        handler.addFilter(quiet)
+    try:
+        yield
+    finally:
+        for handler in handlers:
+            handler.removeFilter(quiet)
+
+
+def _connect(scheduler: str, wait: float) -> Any:
+    """``Client(scheduler)`` within ``wait`` s (+ margin), whatever answers at the address."""
+    from dask.distributed import Client
+
+    hint = f"check the address (--scheduler or ${SCHEDULER_ENV}), or run on a local cluster with --workers N"
+    box: dict[str, Any] = {}
+
+    def connect() -> None:
+        try:
+            box["client"] = Client(scheduler, timeout=wait)
+        except BaseException as exc:  # noqa: BLE001  (reported below, in the caller's thread)
+            box["error"] = exc
+
+    # a server that accepts the connection and never speaks makes Client() wait for ever: a thread with a deadline
+    thread = threading.Thread(target=connect, name="railopt-connect", daemon=True)
+    thread.start()
+    thread.join(wait + SCHEDULER_MARGIN)
+    if thread.is_alive():
+        raise SchedulerError(f"scheduler: {scheduler!r} did not answer as a dask scheduler within "
+                             f"{wait + SCHEDULER_MARGIN:g} s; {hint}")
+    exc = box.get("error")
+    if exc is None:
+        return box["client"]
+    text = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+    if isinstance(exc, KeyboardInterrupt | SystemExit):
+        raise exc
+    if isinstance(exc, ValueError | TypeError):
+        raise SchedulerError(f"scheduler: {scheduler!r} is not a valid address ({exc}); {hint}")
+    if isinstance(exc, OSError):
+        raise SchedulerError(f"scheduler: cannot connect to {scheduler!r} within {wait:g} s ({exc}); {hint}")
+    if isinstance(exc, MemoryError):  # dask took the first bytes of another protocol ("HTTP/1.0") as a frame length
+        text = "its reply is not dask's protocol: an HTTP server, e.g. a dashboard port?"
+    raise SchedulerError(f"scheduler: {scheduler!r} did not answer as a dask scheduler ({text}); {hint}")
+
+
+def _close(client: Any, wait: float) -> None:
+    """Close a client without hanging or raising when its scheduler is gone."""
+    done = threading.Event()
+
+    def close() -> None:
+        try:
+            client.close(timeout=wait)
+        except BaseException:  # noqa: BLE001, S110  (closing a broken connection: nothing to keep)
+            pass
+        finally:
+            done.set()
+
+    threading.Thread(target=close, name="railopt-close", daemon=True).start()
+    done.wait(wait + SCHEDULER_MARGIN)
+
+
 @contextmanager
 def dask_client(workers: int | None = None, scheduler: str | None = None,
                 timeout: float | None = None) -> Iterator[Any]:
@@ -88,34 +429,57 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     ``workers`` = number of worker processes of the embedded cluster (one thread each); ``0``
     yields ``None`` (serial, in-process).  ``$RAILOPT_SCHEDULER`` is used only when neither
     ``scheduler`` nor ``workers`` is given: an explicit request wins over the environment.
-    ``timeout`` (s; default :func:`scheduler_timeout`) bounds the wait for a scheduler: an
-    unreachable one raises :class:`SchedulerError` naming the address.
+    ``timeout`` (s; default :func:`scheduler_timeout`) bounds the wait for a scheduler.
+
+    Raises
+    ------
+    SchedulerError
+        Within ``timeout`` + :data:`SCHEDULER_MARGIN` s, naming the address: not a valid address,
+        nothing listening, something that is not a dask scheduler (or never answers), or a scheduler
+        without workers (none joined within ``timeout``).
+    ValueError
+        ``workers`` < 0, or a bad timeout (naming it).
     """
     if scheduler is None and workers is None:
         scheduler = os.environ.get(SCHEDULER_ENV) or None
     if scheduler is None and workers == 0:
         yield None
         return
-    from dask.distributed import Client, LocalCluster
-
     if scheduler is not None:
         wait = scheduler_timeout(timeout)
-        hint = f"check the address (--scheduler or ${SCHEDULER_ENV}), or run on a local cluster with --workers N"
-        try:
-            client = Client(scheduler, timeout=wait)
-        except (ValueError, TypeError) as exc:
-            raise SchedulerError(f"scheduler: {scheduler!r} is not a valid address ({exc}); {hint}") from None
-        except OSError as exc:
-            raise SchedulerError(f"scheduler: cannot connect to {scheduler!r} within {wait:g} s ({exc}); {hint}"
-                                 ) from None
-        with client:
-            yield client
+        with _quiet_dask_logs():
+            client = _connect(scheduler, wait)
+            _CLIENTS[client] = info = _ClientInfo(str(scheduler), wait, True)
+            try:
+                try:
+                    client.wait_for_workers(1, timeout=wait)
+                except Exception:  # TimeoutError, or the scheduler went away meanwhile
+                    if client.status == "running" and _workers(client, wait) == {}:
+                        raise SchedulerError(_no_workers(info, wait, resume=False)) from None
+                    if client.status != "running":
+                        raise _lost(info, None) from None
+                yield client
+            finally:
+                _close(client, wait)
         return
     n = workers if workers is not None else (os.cpu_count() or 1)
     if n < 0:
         raise ValueError(f"workers: must be ≥ 0, got {n}")
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    # how long the embedded cluster may be without workers (its nannies restart crashed ones) before giving up
+    wait = LOCAL_NO_WORKERS_LIMIT
+    # A start that kills its worker is tried twice, not four times, before it is reported as lost; each worker
+    # holds one task at a time (worker-saturation 1), so a death is held against the task that caused it only.
     with (
-        LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        _quiet_dask_logs(),
+        dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0}),
+        LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                     # the scheduler's HTTP routes on a free local port, not 8787 (taken: a warning on stderr)
+                     scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                     silence_logs=logging.ERROR, preload=[_worker_setup_source()]) as cluster,
         Client(cluster) as client,
     ):
+        _CLIENTS[client] = _ClientInfo(str(cluster.scheduler_address), wait, False)
         yield client

@@ -25,6 +25,7 @@ class Evaluation:
     g: np.ndarray
     df: np.ndarray | None = None
     dg: np.ndarray | None = None
+    replaced: tuple[str, ...] = ()  # supplied Jacobian entries that were not finite, replaced by differences
 
     @property
     def value(self) -> float:
@@ -43,7 +44,8 @@ class MinimaxProblem:
         ``functions(x) -> (m,)`` array; with ``jacobian=True`` it returns ``(f, df)``.
     jacobian : callable, True or None
         ``jacobian(x) -> (m, d)``; ``True`` when ``functions`` returns both; ``None`` for
-        central finite differences.
+        central finite differences.  Infinite or NaN entries of a supplied Jacobian where f is
+        finite (e.g. d√c/dc at c = 0) are replaced by finite differences (one-sided at a bound).
     constraints, constraint_jacobian : callable, optional
         ``g(x) -> (p,)`` and its Jacobian (same conventions as above).
     epsilon : float or (p,) array
@@ -104,41 +106,58 @@ class MinimaxProblem:
 
     # ------------------------------------------------------------------ evaluation
     def _vector(self, fun: VectorFunction, jac: VectorFunction | bool | None, x: np.ndarray, want_grad: bool,
-                field: str, jac_field: str) -> tuple[np.ndarray, np.ndarray | None]:
-        """Value of ``fun`` at x and, when asked, its Jacobian (supplied, returned with it, or FD)."""
+                field: str, jac_field: str) -> tuple[np.ndarray, np.ndarray | None, tuple[str, ...]]:
+        """Value of ``fun`` at x and, when asked, its Jacobian (supplied, returned with it, or FD).
+
+        The third item names the entries of a supplied Jacobian that were not finite (where the value
+        is) and were replaced by finite differences.
+        """
         if jac is True:
             v, dv = fun(x)
         else:
             v = fun(x)
             dv = jac(x) if want_grad and callable(jac) else None
         v = self._as_vector(v, field)
+
+        def values(y: np.ndarray) -> np.ndarray:
+            return self._as_vector(fun(y)[0] if jac is True else fun(y), field)
+
+        replaced: tuple[str, ...] = ()
         if want_grad and dv is None:  # finite differences: a wrong shape is the function's, not a Jacobian's
-            dv = self._fd(lambda y: self._as_vector(fun(y)[0] if jac is True else fun(y), field), x, field, len(v))
+            dv = self._fd(values, x, field, len(v))
         elif dv is not None:
             dv = self._as_jacobian(dv, len(v), jac_field)
-        return v, dv
+            # an infinite or NaN derivative of a finite value (√c at c = 0, a bound): finite differences
+            # for those entries, one-sided into the box at a bound (the only side a solver can move to)
+            bad = ~np.isfinite(dv) & np.isfinite(v)[:, None]
+            if bad.any():
+                replaced = tuple(f"d{field}[{k}]/d{self.space.names[i]} = {dv[k, i]}" for k, i in np.argwhere(bad))
+                fd = self._fd(values, x, field, len(v), columns=np.flatnonzero(bad.any(axis=0)))
+                dv = dv.copy()
+                dv[bad] = fd[bad]
+        return v, dv, replaced
 
-    def _f(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    def _f(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None, tuple[str, ...]]:
         return self._vector(self._functions, self._jacobian, x, want_grad, "functions", "jacobian")
 
-    def _g(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    def _g(self, x: np.ndarray, want_grad: bool) -> tuple[np.ndarray, np.ndarray | None, tuple[str, ...]]:
         if self._constraints is None:
-            return np.zeros(0), (np.zeros((0, self.space.dim)) if want_grad else None)
+            return np.zeros(0), (np.zeros((0, self.space.dim)) if want_grad else None), ()
         return self._vector(self._constraints, self._constraint_jacobian, x, want_grad, "constraints",
                             "constraint_jacobian")
 
     def evaluate(self, x: Sequence[float], gradient: bool = False) -> Evaluation:
         """Evaluate f (and g) at x; Jacobians when ``gradient`` (analytic or finite differences)."""
         x = np.asarray(x, dtype=float)
-        f, df = self._f(x, gradient)
-        g, dg = self._g(x, gradient)
+        f, df, f_replaced = self._f(x, gradient)
+        g, dg, g_replaced = self._g(x, gradient)
         if self.n_functions is None:
             self.n_functions = len(f)
         elif len(f) != self.n_functions:
             raise ValueError(
                 f"functions: returned {len(f)} values, earlier {self.n_functions}; the count must be fixed"
             )
-        return Evaluation(f, g, df, dg)
+        return Evaluation(f, g, df, dg, f_replaced + g_replaced)
 
     def value(self, x: Sequence[float]) -> float:
         """U(x) = max_k f_k(x) (4.74)."""
@@ -153,11 +172,13 @@ class MinimaxProblem:
         return float(max(0.0, np.max(np.where(np.isfinite(excess), excess, np.inf))))
 
     # ------------------------------------------------------------------ derivatives
-    def _fd(self, fun: VectorFunction, x: np.ndarray, field: str = "functions", m: int | None = None) -> np.ndarray:
+    def _fd(self, fun: VectorFunction, x: np.ndarray, field: str = "functions", m: int | None = None,
+            columns: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
         """Central differences, steps of fd_step × range, one-sided at the bounds.
 
-        ``m`` is the number of values ``fun`` returned at x; every step must return as many
-        (a ``ValueError`` naming ``field`` otherwise).
+        Every step lies inside [lower, upper] (x itself is assumed inside).  ``m`` is the number of
+        values ``fun`` returned at x; every step must return as many (a ``ValueError`` naming
+        ``field`` otherwise).  ``columns``: only these variables (the other columns are 0).
         """
         sp = self.space
         m = len(fun(x)) if m is None else m
@@ -170,7 +191,7 @@ class MinimaxProblem:
             return v
 
         J = np.zeros((m, sp.dim))
-        for i in range(sp.dim):
+        for i in range(sp.dim) if columns is None else (int(c) for c in columns):
             h = self.fd_step * (sp.upper[i] - sp.lower[i])
             xp, xm = x.copy(), x.copy()
             xp[i] = min(x[i] + h, sp.upper[i])
@@ -185,7 +206,7 @@ class MinimaxProblem:
         if not self.has_analytic_gradient:
             raise ValueError("jacobian: the problem has no analytic gradient to check")
         x = np.asarray(x, dtype=float)
-        f, df = self._f(x, True)
+        f, df, _ = self._f(x, True)
 
         def fun(y: np.ndarray) -> np.ndarray:
             return self._f(y, False)[0]

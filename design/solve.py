@@ -11,13 +11,22 @@ from typing import Any
 import numpy as np
 
 from railopt.design.methods import METHODS
-from railopt.design.methods.base import COMMON_OPTIONS, EpigraphView, StopSolve
+from railopt.design.methods.base import COMMON_OPTIONS, EpigraphView, Outcome, StopSolve
 from railopt.design.problem import Evaluation, MinimaxProblem
-from railopt.design.result import SolveResult
+from railopt.design.result import SUCCESS_STATUSES, SolveResult
+
+MAX_EVAL = 2**31 - 1  # NLopt's set_maxeval takes a C int
 
 
 def method_options(method: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Merge defaults and user options; unknown methods or option names raise naming the field."""
+    """Merge defaults and user options; unknown methods or option names raise naming the field.
+
+    Raises
+    ------
+    ValueError
+        Naming ``method`` or ``options.<name>``: an unknown method or option, a tolerance or time
+        that is not a positive finite number, or ``maxeval`` not an integer in [1, 2**31 − 1].
+    """
     if method not in METHODS:
         raise ValueError(f"method: unknown method {method!r}; registered: {sorted(METHODS)}")
     spec = METHODS[method]
@@ -26,7 +35,7 @@ def method_options(method: str, options: dict[str, Any] | None = None) -> dict[s
         if key not in merged:
             raise ValueError(f"options.{key}: unknown option for method {method!r}; known: {sorted(merged)}")
         merged[key] = value
-    for key in ("xtol", "ftol", "maxtime"):
+    for key in ("xtol", "ftol", "maxtime", *(k for k in ("initial_step", "initial_radius", "penalty") if k in merged)):
         value = merged[key]
         if isinstance(value, bool) or not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
             raise ValueError(f"options.{key}: must be a positive number, got {value!r}")
@@ -34,6 +43,9 @@ def method_options(method: str, options: dict[str, Any] | None = None) -> dict[s
     value = merged["maxeval"]
     if isinstance(value, bool) or not (isinstance(value, numbers.Integral) and value > 0):
         raise ValueError(f"options.maxeval: must be a positive integer, got {value!r}")
+    if value > MAX_EVAL:
+        raise ValueError(f"options.maxeval: {value} is more than NLopt accepts (a C int: at most 2**31 - 1 = "
+                         f"{MAX_EVAL})")
     merged["maxeval"] = int(value)
     return merged
 
@@ -65,7 +77,15 @@ def solve(problem: MinimaxProblem, x0: Sequence[float], method: str = "slsqp", *
         view = EpigraphView(problem, x0, opts)
     except StopSolve as stop:  # the model fails at the start point itself
         return _result(problem, x0, x0, None, np.inf, stop.status, stop.message, 0, start, method)
-    outcome = METHODS[method].run(view, problem.space.to_u(x0), opts)
+    try:
+        outcome = METHODS[method].run(view, problem.space.to_u(x0), opts)
+    except StopSolve as stop:
+        outcome = Outcome(problem.space.to_u(view.best_x), view.best_merit, stop.status, stop.message)
+    except Exception as exc:  # anything else a method lets through: a status with the best point, never a raise
+        outcome = Outcome(problem.space.to_u(view.best_x), view.best_merit, "failure",
+                          f"{method} raised {type(exc).__name__}: {exc}")
+    if outcome.status not in SUCCESS_STATUSES and view.gradient_note:  # say why a solver may have failed
+        outcome = Outcome(outcome.u, outcome.tau, outcome.status, f"{outcome.message}; {view.gradient_note}")
     # re-evaluate ourselves: the solver's point, or the best point it evaluated if that is better
     x_solver = problem.space.to_x(np.clip(outcome.u, 0.0, 1.0))
     evaluated = [(x_solver, _safe_evaluate(problem, x_solver))]

@@ -12,6 +12,8 @@ from scipy.stats import qmc
 from railopt.design.variables import Space
 
 SAMPLERS = ("sobol", "lhs")
+MAX_STARTS = 10**7  # starts per campaign (user points plus sampled ones): one store row and one task each
+MAX_SEED = 2**63 - 1  # the seed is stored in the campaign store as a SQLite INTEGER (signed 64-bit)
 
 
 @dataclass(frozen=True)
@@ -30,13 +32,29 @@ def start_points(
     seed: int = 0,
     points: Sequence[Sequence[float]] | None = None,
 ) -> list[Start]:
-    """User ``points`` first (ids 0..), then ``n_starts`` quasi-random points (same seed → same starts)."""
-    if not isinstance(n_starts, int | np.integer) or isinstance(n_starts, bool) or n_starts <= 0:
-        raise ValueError(f"n_starts: must be a positive integer, got {n_starts!r}")
+    """User ``points`` first (ids 0..), then ``n_starts`` quasi-random points (same seed → same starts).
+
+    Parameters
+    ----------
+    space : Space
+        The design variables.
+    n_starts : int
+        Number of sampled starts, 1 ≤ n_starts and ``len(points) + n_starts`` ≤ :data:`MAX_STARTS` (10**7).
+    sampler : {"sobol", "lhs"}
+    seed : int
+        0 ≤ seed ≤ :data:`MAX_SEED` (2**63 − 1, what the campaign store's INTEGER column holds).
+    points : sequence of designs, optional
+        User starts, each inside the bounds.
+
+    Raises
+    ------
+    ValueError
+        Naming the field (``n_starts``, ``sampler``, ``seed``, ``points[i]``), before any sampling.
+    """
+    check_count("n_starts", n_starts, MAX_STARTS - len(points or []))
     if sampler not in SAMPLERS:
         raise ValueError(f"sampler: must be one of {SAMPLERS}, got {sampler!r}")
-    if not isinstance(seed, int | np.integer) or isinstance(seed, bool) or seed < 0:
-        raise ValueError(f"seed: must be a non-negative integer, got {seed!r}")
+    check_seed(seed)
     starts = [Start(i, "user", space.check_point(p, field=f"points[{i}]")) for i, p in enumerate(points or [])]
     rng = np.random.default_rng(seed)
     if sampler == "sobol":
@@ -49,3 +67,21 @@ def start_points(
     base = len(starts)
     starts += [Start(base + i, sampler, space.to_x(ui)) for i, ui in enumerate(u)]
     return starts
+
+
+def check_count(field: str, value: object, limit: int, lowest: int = 1) -> int:
+    """``value`` as an int if it is an integer in [lowest, limit]; else a ``ValueError`` naming ``field``."""
+    if not isinstance(value, int | np.integer) or isinstance(value, bool | np.bool_) or value < lowest:
+        raise ValueError(f"{field}: must be an integer ≥ {lowest}, got {value!r}")
+    if value > limit:
+        raise ValueError(f"{field}: {value} is more than the limit {limit}")
+    return int(value)
+
+
+def check_seed(seed: object) -> int:
+    """A seed as an int if 0 ≤ seed ≤ 2**63 − 1 (it is stored as a SQLite INTEGER); else ``ValueError`` naming it."""
+    if not isinstance(seed, int | np.integer) or isinstance(seed, bool | np.bool_) or seed < 0:
+        raise ValueError(f"seed: must be a non-negative integer, got {seed!r}")
+    if seed > MAX_SEED:
+        raise ValueError(f"seed: {seed} does not fit in a signed 64-bit integer (at most 2**63 - 1 = {MAX_SEED})")
+    return int(seed)

@@ -6,6 +6,27 @@ campaign loses at most the starts that were running; ``--resume`` skips the fini
 JSON, and the campaign config is stored with its SHA-256 so that a resume with a different
 config is refused.
 
+Concurrency.  While a writer has a store open it runs in SQLite's WAL journal mode, with a busy
+timeout of :data:`BUSY_TIMEOUT` s: readers never block the writer and the writer never blocks
+readers, so a progress monitor or a notebook may read a live store while a campaign writes it.
+Closing the writer checkpoints the log into the file and returns it to the rollback journal (one
+self-contained file), unless a reader is still attached (it then stays in WAL mode, as safely).  To read a live
+store use ``CampaignStore.open(path, read_only=True)``, or plain SQLite::
+
+    db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+    rows = db.execute("SELECT start_id, status, value FROM starts").fetchall()  # fetch all, then
+    db.close()                                                                   # let go of it
+
+A reader that keeps a read transaction open (an unconsumed cursor) does not block the campaign,
+but the write-ahead log cannot be folded back into the file while it lasts, so finish reads
+promptly.  The ``<store>-wal`` and ``<store>-shm`` files next to a store are part of it while it is
+open (and after a writer was killed: the next open recovers the committed starts from them): copy
+or move a store only when no process has it open, with those files if they exist.
+
+Starts that killed every worker they ran on are stored with status ``worker_lost`` (x = x0, value
++inf); a resume skips them unless asked to retry them (``finished_ids(retry_failed=True)``), and a
+retried start replaces its ``worker_lost`` row.  Schema version 1 holds all of this.
+
 A store is created whole or not at all: it is initialised under a temporary name and linked
 into place, which fails if the name is taken — two processes creating one store cannot both
 succeed, and neither deletes a file it did not make.  Opening checks the file (SQLite header,
@@ -32,6 +53,8 @@ import numpy as np
 import pandas as pd
 
 SCHEMA_VERSION = 1
+BUSY_TIMEOUT = 30.0  # s a write waits for another writer's lock (readers never lock the writer out in WAL mode)
+RETRYABLE_STATUSES = ("worker_lost",)  # rows a resume re-runs when asked to (retry_failed)
 TABLES = ("meta", "campaign", "starts", "checks")
 _HEADER = b"SQLite format 3\x00"
 
@@ -99,6 +122,21 @@ CREATE TABLE IF NOT EXISTS checks (
     PRIMARY KEY (start_id, name)
 );
 """
+
+
+def _marks(values: Sequence[object]) -> str:
+    return ",".join("?" * len(values))
+
+
+def _configure(path: Path, db: sqlite3.Connection, read_only: bool) -> None:
+    """The busy timeout and, for a writer, WAL journal mode (until :meth:`CampaignStore.close`)."""
+    try:
+        if not read_only:
+            db.execute("PRAGMA busy_timeout = 2000")  # a reader in rollback mode holds the switch: not for long
+            db.execute("PRAGMA journal_mode = WAL").fetchall()
+    except sqlite3.OperationalError:  # held by another process, or not writable: the store keeps its journal mode
+        pass  # (a write that then fails raises a StoreError naming the file and what was being written)
+    db.execute(f"PRAGMA busy_timeout = {int(BUSY_TIMEOUT * 1000)}")
 
 
 def config_hash(config: Mapping[str, Any]) -> str:
@@ -184,9 +222,12 @@ def _check_store(path: Path, db: sqlite3.Connection, expect_config: Mapping[str,
 class CampaignStore:
     """One campaign's SQLite file.  Use :meth:`create` for a new campaign, :meth:`open` to read/resume."""
 
-    def __init__(self, path: Path, connection: sqlite3.Connection) -> None:
+    def __init__(self, path: Path, connection: sqlite3.Connection, read_only: bool = False) -> None:
         self.path = Path(path)
         self._db = connection
+        self.read_only = read_only
+        if str(path) != ":memory:":
+            _configure(self.path, connection, read_only)
 
     # ------------------------------------------------------------------ opening
     @classmethod
@@ -211,9 +252,17 @@ class CampaignStore:
             _link_exclusive(tmp, path)
         except sqlite3.Error as exc:
             raise _sqlite_error(path, exc, "create") from None
+        except FileExistsError:
+            raise
+        except OSError as exc:  # a full disk, a read-only folder: the error of write() names no file
+            raise StoreError(f"store: cannot create {path}: {exc.strerror or exc}; free space or choose another "
+                             "--results") from None
         finally:
             tmp.unlink(missing_ok=True)
-        return cls(path, sqlite3.connect(path))
+        try:
+            return cls(path, sqlite3.connect(path, timeout=BUSY_TIMEOUT))
+        except sqlite3.Error as exc:
+            raise _sqlite_error(path, exc, "open") from None
 
     @classmethod
     def in_memory(cls, variables: Sequence[str], name: str = "in-memory") -> CampaignStore:
@@ -223,10 +272,13 @@ class CampaignStore:
         return cls(Path(":memory:"), db)
 
     @classmethod
-    def open(cls, path: str | Path, expect_config: Mapping[str, Any] | None = None) -> CampaignStore:
+    def open(cls, path: str | Path, expect_config: Mapping[str, Any] | None = None,
+             read_only: bool = False) -> CampaignStore:
         """Open an existing store; with ``expect_config`` refuse one made from another config.
 
-        Raises :class:`StoreDamaged` (naming the file) if it is not an intact campaign store.
+        ``read_only=True`` opens it for reading only (safe on a store a campaign is writing).
+        Raises :class:`StoreDamaged` (naming the file) if it is not an intact campaign store, and
+        :class:`StoreError` (naming it) if it cannot be opened or is of another schema version.
         """
         path = Path(path)
         if not path.exists():
@@ -240,19 +292,30 @@ class CampaignStore:
         if header != _HEADER:
             raise StoreDamaged(path, "not an SQLite database: bad header")
         try:
-            db = sqlite3.connect(f"{path.resolve().as_uri()}?mode=rw", uri=True)
+            db = sqlite3.connect(f"{path.resolve().as_uri()}?mode={'ro' if read_only else 'rw'}", uri=True,
+                                 timeout=BUSY_TIMEOUT)
         except sqlite3.Error as exc:
             raise _sqlite_error(path, exc, "open") from None
         try:
             _check_store(path, db, expect_config)
+            return cls(path, db, read_only)
         except BaseException as exc:
             db.close()
             if isinstance(exc, sqlite3.Error):
                 raise _sqlite_error(path, exc, "read") from None
             raise
-        return cls(path, db)
 
     def close(self) -> None:
+        """Checkpoint the write-ahead log into the store file (without waiting for readers), then close."""
+        if str(self.path) != ":memory:" and not self.read_only:
+            try:
+                self._db.execute("PRAGMA busy_timeout = 0")  # a reader still attached: leave the log for later
+                self._db.execute("PRAGMA wal_checkpoint(TRUNCATE)").fetchall()
+                # back to a single self-contained file (no -wal/-shm left by later readers); a reader still
+                # attached keeps it in WAL mode, which is as safe
+                self._db.execute("PRAGMA journal_mode = DELETE").fetchall()
+            except sqlite3.Error:  # the log stays next to the file; the next open folds it in
+                pass
         self._db.close()
 
     def __enter__(self) -> CampaignStore:
@@ -262,6 +325,14 @@ class CampaignStore:
         self.close()
 
     # ------------------------------------------------------------------ writing
+    @contextmanager
+    def _reading(self) -> Iterator[None]:
+        """SQLite failures while reading become a :class:`StoreError` naming the file."""
+        try:
+            yield
+        except sqlite3.Error as exc:
+            raise _sqlite_error(self.path, exc, "read") from None
+
     @contextmanager
     def _writing(self, what: str) -> Iterator[None]:
         """One transaction; SQLite failures become a :class:`StoreError` naming the file."""
@@ -275,8 +346,14 @@ class CampaignStore:
             raise _sqlite_error(self.path, exc, f"write {what} to") from None
 
     def add_start(self, start_id: int, origin: str, seed: int, result: Any) -> None:
-        """Record one finished start (a :class:`~railopt.design.result.SolveResult`) atomically."""
+        """Record one finished start (a :class:`~railopt.design.result.SolveResult`) atomically.
+
+        A start already stored raises :class:`DuplicateStart`, unless its stored status is one of
+        :data:`RETRYABLE_STATUSES` (a retried start): then the new result replaces it.
+        """
         with self._writing(f"start {start_id}"):
+            self._db.execute(f"DELETE FROM starts WHERE start_id = ? AND status IN ({_marks(RETRYABLE_STATUSES)})",
+                             (int(start_id), *RETRYABLE_STATUSES))
             self._db.execute(
                 "INSERT INTO starts VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
                 (int(start_id), origin, _vec(result.x0), _vec(result.x), _num(result.value), _num(result.t),
@@ -307,12 +384,26 @@ class CampaignStore:
     def variables(self) -> list[str]:
         return json.loads(self._db.execute("SELECT variables_json FROM campaign").fetchone()[0])
 
-    def finished_ids(self) -> set[int]:
-        return {r[0] for r in self._db.execute("SELECT start_id FROM starts")}
+    def finished_ids(self, retry_failed: bool = False) -> set[int]:
+        """Ids a resume skips: every stored start, or with ``retry_failed`` all but the ``worker_lost`` ones."""
+        with self._reading():
+            if retry_failed:
+                rows = self._db.execute(
+                    f"SELECT start_id FROM starts WHERE status NOT IN ({_marks(RETRYABLE_STATUSES)})",
+                    RETRYABLE_STATUSES)
+            else:
+                rows = self._db.execute("SELECT start_id FROM starts")
+            return {r[0] for r in rows}
+
+    def lost_ids(self) -> set[int]:
+        """Ids of the stored starts that killed every worker they ran on (status ``worker_lost``)."""
+        with self._reading():
+            return {r[0] for r in self._db.execute("SELECT start_id FROM starts WHERE status = 'worker_lost'")}
 
     def starts(self) -> pd.DataFrame:
         """One row per finished start, sorted by start_id; x0 and x expanded to named columns."""
-        df = pd.read_sql_query("SELECT * FROM starts ORDER BY start_id", self._db)
+        with self._reading():
+            df = pd.read_sql_query("SELECT * FROM starts ORDER BY start_id", self._db)
         names = self.variables()
         x0 = np.array([_unvec(s) for s in df["x0_json"]]).reshape(len(df), len(names))
         x = np.array([_unvec(s) for s in df["x_json"]]).reshape(len(df), len(names))
@@ -325,6 +416,7 @@ class CampaignStore:
         return df.drop(columns=["x0_json", "x_json", "functions_json"])
 
     def checks(self) -> pd.DataFrame:
-        df = pd.read_sql_query("SELECT * FROM checks ORDER BY start_id, name", self._db)
+        with self._reading():
+            df = pd.read_sql_query("SELECT * FROM checks ORDER BY start_id, name", self._db)
         df["payload"] = [json.loads(s) for s in df.pop("payload_json")]
         return df

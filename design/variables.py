@@ -65,8 +65,18 @@ class Space:
         return len(self.variables)
 
     def to_x(self, u: np.ndarray) -> np.ndarray:
-        y = self._lo + np.asarray(u, dtype=float) * (self._hi - self._lo)
-        return np.where(self.log, np.exp(y), y)
+        """Design x (units of each variable) at unit-cube coordinates u, shape (..., d).
+
+        The result is always inside [lower, upper], and u = 0, 1 give the bounds exactly: the log map
+        may round one or two ULP past a bound (0.3 → 0.30000000000000004), so the result is clipped;
+        ``exp`` is evaluated on the log-scaled entries only (no overflow warning for large linear values).
+        """
+        u = np.asarray(u, dtype=float)
+        y = self._lo + u * (self._hi - self._lo)
+        with np.errstate(over="ignore"):  # u far outside [0, 1] on a log variable: clipped to the bound below
+            x = np.where(self.log, np.exp(np.where(self.log, y, 0.0)), y)
+        x = np.where(u <= 0.0, self.lower, np.where(u >= 1.0, self.upper, x))  # the bounds themselves, exactly
+        return np.clip(x, self.lower, self.upper)
 
     def to_u(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float)
@@ -77,7 +87,7 @@ class Space:
     def dx_du(self, u: np.ndarray) -> np.ndarray:
         """Diagonal of dx/du, shape (d,)."""
         span = self._hi - self._lo
-        return np.where(self.log, self.to_x(u) * span, span)
+        return np.where(self.log, self.to_x(u) * np.where(self.log, span, 1.0), span)
 
     def bound_violation(self, x: np.ndarray) -> float:
         """Largest bound excess of x, relative to each variable's range (0 when inside)."""
@@ -94,4 +104,4 @@ class Space:
         if self.bound_violation(x) > 1e-12:
             bad = [n for n, xi, lo, hi in zip(self.names, x, self.lower, self.upper, strict=True) if not lo <= xi <= hi]
             raise ValueError(f"{field}: outside the bounds for {bad}")
-        return x
+        return np.clip(x, self.lower, self.upper)  # within the 1e-12 tolerance: onto the bound, never past it

@@ -46,6 +46,7 @@ class EpigraphView:
         self.start_time = time.perf_counter()
         self.best_x = np.asarray(x0, dtype=float).copy()
         self.best_merit = np.inf
+        self.gradient_note: str | None = None  # the first non-finite Jacobian entry met (replaced by differences)
         ev0 = self._raw(self.best_x, gradient=False)
         u0_value = ev0.value
         self.scale = max(abs(u0_value), 1.0) if np.isfinite(u0_value) else 1.0
@@ -61,6 +62,9 @@ class EpigraphView:
         except Exception as exc:  # the user's model failed: keep the best point, report it
             raise StopSolve("error", f"{type(exc).__name__}: {exc}") from exc
         self.evaluations += 1
+        if ev.replaced and self.gradient_note is None:
+            self.gradient_note = (f"non-finite gradient {ev.replaced[0]} at x = {np.asarray(x).tolist()} "
+                                  "(replaced by a one-sided finite difference)")
         violation = self.problem.constraint_violation(x, ev)
         merit = ev.value if violation <= 1e-9 else np.inf
         if merit < self.best_merit:
@@ -83,6 +87,12 @@ class EpigraphView:
             dg = ev.dg * chain[None, :] / self.scale
             df[~np.isfinite(f)] = 0.0
             dg[~np.isfinite(g)] = 0.0
+            for jac, name in ((df, "functions"), (dg, "constraints")):
+                bad = np.argwhere(~np.isfinite(jac))
+                if bad.size:  # the problem already replaced non-finite analytic entries by differences
+                    k, i = bad[0]
+                    raise StopSolve("failure", f"non-finite gradient d{name}[{k}]/d{self.space.names[i]} = "
+                                               f"{jac[k, i]} at x = {x.tolist()}")
         f = np.where(np.isfinite(f), f, BIG)
         g = np.where(np.isfinite(g), g, BIG)
         return f, df, g, dg

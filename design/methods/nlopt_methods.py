@@ -88,8 +88,9 @@ class NloptMethod:
             return self._best(view, "roundoff_limited", f"RoundoffLimited: {exc}")
         except nlopt.ForcedStop as exc:
             return self._best(view, "forced_stop", f"ForcedStop: {exc}")
-        except (RuntimeError, ValueError) as exc:  # NLOPT_FAILURE / INVALID_ARGS
-            return self._best(view, "failure", f"{type(exc).__name__}: {exc}")
+        except (RuntimeError, ValueError, getattr(nlopt, "exception", RuntimeError)) as exc:  # NLOPT_FAILURE etc.
+            # NLopt's generic failure (SLSQP: iteration limit, singular QP, a huge gradient) may carry no text
+            return self._best(view, "failure", f"NLopt {type(exc).__name__}: {str(exc) or 'NLOPT_FAILURE'}")
 
     @staticmethod
     def _best(view: EpigraphView, status: str, message: str) -> Outcome:

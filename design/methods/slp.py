@@ -62,7 +62,11 @@ class SLPMethod:
                 fp.value, Jp.value, up.value, radius.value = f, df, u, delta
                 if p:
                     gp.value, Jgp.value = g, dg
-                lp.solve(solver=options["lp_solver"])
+                try:
+                    lp.solve(solver=options["lp_solver"])
+                except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # e.g. NaN/inf problem data
+                    best = view.space.to_u(view.best_x)
+                    return Outcome(best, view.best_merit, "failure", f"LP subproblem: {type(exc).__name__}: {exc}")
                 if lp.status not in ("optimal", "optimal_inaccurate") or step.value is None:
                     return Outcome(u, phi * view.scale, "failure", f"LP subproblem {lp.status}")
                 tau = float(t.value)

@@ -1,0 +1,333 @@
+"""Faults of the dask paths: a start that kills its worker, unpicklable problems, wrong or lost schedulers.
+
+Real processes only (an embedded LocalCluster, ``dask scheduler``/``dask worker`` subprocesses, TCP servers on
+127.0.0.1), each bounded in time.  Values are checked against the closed form of the test problem:
+f = ((a − 0.6)² + b, (b − 0.2)² + 0.1) on [0, 1]², U* = 0.7 − √0.35 = 0.108392 at a = 0.6 where f1 = f2.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from railopt.design import (
+    CampaignStore,
+    DesignVariable,
+    MinimaxProblem,
+    check_designs,
+    epsilon_sweep,
+    multistart,
+    objective_surface,
+)
+from railopt.design.parallel import SCHEDULER_MARGIN, SchedulerError, dask_client, map_unordered
+
+U_STAR = 0.7 - np.sqrt(0.35)
+VARIABLES = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0)]
+
+
+def _f(x: np.ndarray) -> np.ndarray:
+    return np.array([(x[0] - 0.6) ** 2 + x[1], (x[1] - 0.2) ** 2 + 0.1])
+
+
+@dataclass(frozen=True)
+class Poisoned:
+    """The model crashes its process (as a segfault in native code would) for a < 0.12, after noting it in ``log``."""
+
+    log: str
+    crash: bool = True
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        if self.crash and x[0] < 0.12:
+            with open(self.log, "a") as fh:
+                fh.write(f"{os.getpid()}\n")
+            os._exit(1)
+        return _f(x)
+
+
+def _crashes(log: Path) -> int:
+    return len(log.read_text().splitlines()) if log.exists() else 0
+
+
+@pytest.mark.timeout(240)
+def test_a_start_that_kills_its_worker_is_stored_as_lost_and_not_retried_unless_asked(tmp_path: Path) -> None:
+    log = tmp_path / "crashes.txt"
+    path = tmp_path / "poison.sqlite"
+    poisoned = MinimaxProblem(VARIABLES, Poisoned(str(log)))
+    args = {"n_starts": 7, "method": "slsqp", "seed": 3, "points": [[0.05, 0.5]]}
+    with dask_client(workers=2) as client, CampaignStore.create(path, "p", {}, ["a", "b"]) as store:
+        table = multistart(poisoned, client=client, store=store, **args)
+        assert list(table["start_id"]) == list(range(8))
+        lost = table[table["status"] == "worker_lost"]
+        assert 0 in set(lost["start_id"])  # the user point a = 0.05 < 0.12
+        assert lost["message"].str.contains("worker lost").all() and lost["message"].str.contains("tcp://").all()
+        assert np.all(np.isinf(lost["value"])) and not lost["success"].any()
+        solved = table[table["status"] == "converged"]
+        assert len(solved) + len(lost) == 8 and len(solved) >= 4
+        np.testing.assert_allclose(solved["value"], U_STAR, atol=1e-7)  # closed form
+        crashes = _crashes(log)
+        assert crashes == 2 * len(lost)  # each lost start was tried on two workers (allowed-failures = 1), no other
+
+        # a resume does not try the lost starts again: no new crash, the table unchanged
+        again = multistart(poisoned, client=client, store=store, **args)
+        assert _crashes(log) == crashes
+        assert list(again["status"]) == list(table["status"])
+
+        # asked to, it retries them (the model fixed): each replaced once, every start stored exactly once
+        fixed = MinimaxProblem(VARIABLES, Poisoned(str(log), crash=False))
+        retried = multistart(fixed, client=client, store=store, retry_failed=True, **args)
+        assert _crashes(log) == crashes
+        assert list(retried["start_id"]) == list(range(8)) and set(retried["status"]) == {"converged"}
+        np.testing.assert_allclose(retried["value"], U_STAR, atol=1e-7)
+        assert store.lost_ids() == set()
+    # the finished rows were never rewritten by the resumes
+    with CampaignStore.open(path, read_only=True) as s:
+        rows = s.starts().set_index("start_id")
+    kept = table.set_index("start_id")
+    ok = kept["status"] == "converged"
+    np.testing.assert_array_equal(rows.loc[ok[ok].index, "value"], kept.loc[ok, "value"])
+
+
+# ---------------------------------------------------------------------- unpicklable problems
+
+
+def _locked_problem() -> tuple[MinimaxProblem, threading.Lock]:
+    lock = threading.Lock()
+
+    def functions(x: np.ndarray) -> np.ndarray:
+        with lock:
+            return _f(x)
+
+    def g(x: np.ndarray) -> np.ndarray:
+        with lock:
+            return np.array([x[1]])
+
+    return MinimaxProblem(VARIABLES, functions, constraints=g, epsilon=0.5), lock
+
+
+@pytest.fixture(scope="module")
+def client():
+    with dask_client(workers=1) as c:
+        yield c
+
+
+@pytest.mark.timeout(120)
+def test_an_unpicklable_problem_is_named_before_anything_is_submitted(client, tmp_path: Path) -> None:
+    problem, _ = _locked_problem()
+    # serially it runs, and gives the closed-form optimum
+    serial = multistart(problem, 4, seed=0)
+    assert serial["value"].min() == pytest.approx(U_STAR, abs=1e-7)
+    with CampaignStore.create(tmp_path / "c.sqlite", "c", {}, ["a", "b"]) as store:
+        with pytest.raises(ValueError, match=r"^problem\.functions\.lock: cannot be sent to dask workers "
+                                             r"\(TypeError: cannot pickle '_thread\.lock' object\).*workers=0"):
+            multistart(problem, 4, seed=0, client=client, store=store)
+        assert store.finished_ids() == set()  # refused before any start was solved
+    assert client.who_has() == {} or not any(client.who_has().values())  # nothing was submitted
+    with pytest.raises(ValueError, match=r"^problem\.functions\.lock: cannot be sent"):
+        objective_surface(problem, ("a", "b"), [0.1, 0.2], [0.3], [0.5, 0.5], client=client)
+    with pytest.raises(ValueError, match=r"^problem\.functions\.lock: cannot be sent"):
+        epsilon_sweep(problem, [0.3], n_starts=2, client=client)
+    lock = threading.Lock()
+
+    def check(x: np.ndarray) -> tuple[float, dict]:
+        with lock:
+            return float(x[0]), {}
+
+    designs = serial[["start_id", "a", "b"]]
+    with pytest.raises(ValueError, match=r"^check\.lock: cannot be sent to dask workers"):
+        check_designs(check, designs, ["a", "b"], "c", client=client)
+    with pytest.raises(ValueError, match=r"^\[0\]: cannot be sent|^lock: cannot be sent|cannot be sent"):
+        list(map_unordered(len, [[threading.Lock()]], client=client))
+    # the same checks on a picklable problem pass and agree with the serial run (second method)
+    plain = MinimaxProblem(VARIABLES, _f)
+    on_dask = multistart(plain, 4, seed=0, client=client)
+    np.testing.assert_allclose(on_dask["value"], multistart(plain, 4, seed=0)["value"], rtol=0, atol=0)
+
+
+# ---------------------------------------------------------------------- schedulers
+
+
+def _serve(reply: bytes | None) -> tuple[socket.socket, list[socket.socket]]:
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    held: list[socket.socket] = []
+
+    def loop() -> None:
+        while True:
+            try:
+                conn, _ = srv.accept()
+            except OSError:
+                return
+            if reply:
+                try:
+                    conn.sendall(reply)
+                except OSError:
+                    pass
+            held.append(conn)
+
+    threading.Thread(target=loop, daemon=True).start()
+    return srv, held
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(("reply", "said"), [
+    (b"HTTP/1.0 400 Bad Request\r\n\r\nnot dask\r\n" * 50, "did not answer as a dask scheduler"),
+    (None, "did not answer as a dask scheduler within"),
+], ids=["http-server", "silent-server"])
+def test_a_server_that_is_not_a_scheduler_fails_within_the_timeout(reply: bytes | None, said: str) -> None:
+    srv, held = _serve(reply)
+    address = f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+    began = time.monotonic()
+    with pytest.raises(SchedulerError, match=said) as err, dask_client(scheduler=address, timeout=2):
+        pass
+    elapsed = time.monotonic() - began
+    assert address in str(err.value) and "--workers N" in str(err.value)
+    assert elapsed < 2 + SCHEDULER_MARGIN + 2, elapsed
+    srv.close()
+    for c in held:
+        c.close()
+
+
+def _free_port() -> int:
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def _start(*args: str) -> subprocess.Popen:
+    """A dask process in its own session; it can import this module (the tasks' classes live here)."""
+    path = os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")])
+    return subprocess.Popen([sys.executable, "-m", *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True, env={**os.environ, "PYTHONPATH": path})
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGKILL)  # started by this test in its own session
+    proc.wait()
+
+
+def _wait_for_port(port: int, limit: float = 30.0) -> None:
+    end = time.monotonic() + limit
+    while time.monotonic() < end:
+        with socket.socket() as s:
+            if s.connect_ex(("127.0.0.1", port)) == 0:
+                return
+        time.sleep(0.1)
+    raise AssertionError(f"no scheduler on port {port}")
+
+
+@pytest.fixture
+def scheduler():
+    port = _free_port()
+    proc = _start("distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard")
+    _wait_for_port(port)
+    yield f"tcp://127.0.0.1:{port}", proc
+    _stop(proc)
+
+
+@pytest.mark.timeout(60)
+def test_a_scheduler_without_workers_is_named_within_the_timeout(scheduler) -> None:
+    address, _ = scheduler
+    began = time.monotonic()
+    with pytest.raises(SchedulerError, match="has no workers") as err, dask_client(scheduler=address, timeout=2):
+        pass
+    assert address in str(err.value)
+    assert time.monotonic() - began < 2 + SCHEDULER_MARGIN + 2
+
+
+@dataclass(frozen=True)
+class Slow:
+    """f of the closed-form problem, 20 ms per evaluation (a start takes about a second)."""
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        time.sleep(0.02)
+        return _f(x)
+
+
+@pytest.mark.timeout(180)
+def test_a_lost_scheduler_is_one_error_and_the_finished_starts_are_kept(scheduler, tmp_path: Path) -> None:
+    address, proc = scheduler
+    worker = _start("distributed.cli.dask_worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard")
+    path = tmp_path / "c.sqlite"
+    problem = MinimaxProblem(VARIABLES, Slow())
+    killed_at: list[float] = []
+
+    def kill_after_two(done: int, total: int) -> None:
+        if done >= 2 and not killed_at:
+            os.killpg(proc.pid, signal.SIGKILL)
+            killed_at.append(time.monotonic())
+
+    try:
+        with CampaignStore.create(path, "c", {}, ["a", "b"]) as store:
+            with pytest.raises(SchedulerError) as err, dask_client(scheduler=address, timeout=3) as client:
+                multistart(problem, 12, seed=2, client=client, store=store, progress=kill_after_two)
+            waited = time.monotonic() - killed_at[0]
+            kept = store.starts()
+    finally:
+        _stop(worker)
+    assert str(err.value) == (f"scheduler: lost the connection to {address!r}; finished starts are kept, "
+                              "rerun with --resume")
+    assert waited < 3 + SCHEDULER_MARGIN + 5, waited
+    assert 2 <= len(kept) < 12
+    # the resume (serial) completes every start exactly once and keeps the finished ones as they were
+    with CampaignStore.open(path) as store:
+        table = multistart(problem, 12, seed=2, store=store)
+    assert list(table["start_id"]) == list(range(12))
+    np.testing.assert_allclose(table["value"].min(), U_STAR, atol=1e-7)
+    again = table.set_index("start_id").loc[kept["start_id"]]
+    np.testing.assert_array_equal(again["value"], kept["value"].to_numpy())
+
+
+CTRL_C = """
+import sys, time
+from railopt.design.parallel import dask_client, map_unordered
+
+
+def slow(i):
+    time.sleep(0.2)
+    return i
+
+
+if __name__ == "__main__":
+    try:
+        with dask_client(workers=2) as client:
+            print("pids", *client.run(lambda: __import__("os").getpid()).values(), flush=True)
+            for i in map_unordered(slow, range(10_000), client=client):
+                if i == 3:
+                    print("running", flush=True)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        sys.exit(130)
+"""
+
+
+@pytest.mark.timeout(120)
+def test_ctrl_c_to_the_process_group_prints_no_worker_traceback(tmp_path: Path) -> None:
+    """SIGINT to the whole group (what Ctrl-C in a terminal does): the workers ignore it, dask says nothing."""
+    script = tmp_path / "ctrl_c.py"
+    script.write_text(CTRL_C)
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    pids = [int(p) for p in proc.stdout.readline().split()[1:]]
+    assert len(pids) == 2
+    assert proc.stdout.readline().strip() == "running"
+    os.killpg(proc.pid, signal.SIGINT)  # the group this test started
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.strip() == "interrupted", err  # no "Traceback", no "KeyboardInterrupt", no dask WARNING lines
+    for pid in pids:  # the workers were shut down by the main process, not killed by the signal
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
