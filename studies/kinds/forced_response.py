@@ -6,7 +6,8 @@ flexible-track model, the figure panels — one output each — and the bands). 
 writes the FRF of every panel output on both tracks (``frf.csv``: amplitude per the given
 irregularity amplitude, phase relative to the profile at the leading axle), the certified exact
 band maxima and the flexible/rigid ratio (``peaks.csv``), the damped natural frequencies of the
-flexible model above a threshold (``modes.csv``: the modes of the track carrying the wheelsets), one
+flexible model above a threshold (``modes.csv``, named by kinetic-energy shares: "track" for the track carrying
+the wheelsets, "front truck pitch", ...), one
 figure per panel (rigid vs flexible on one axes, thesis figure label) and ``summary.md``.
 
 A group with ``wavelength_m`` runs the thesis's own sweep instead: a fixed wavelength L, each frequency
@@ -25,7 +26,7 @@ from pydantic import Field, model_validator
 
 from railopt.models import all_response_maxima
 from railopt.models.peak_search import grid_maximum
-from railopt.models.stability import spectral_abscissa
+from railopt.models.stability import modes, spectral_abscissa
 from railopt.models.units import FOOT, INCH, MPH
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.catalog import ModelsStudy, require_unique
@@ -217,7 +218,7 @@ def _track_responses(cfg: ForcedResponseConfig, g: GroupSpec, track: str, entry:
                                   "quantity": quantity, "unit": unit, "track": track, "peak": value,
                                   "frequency_hz": f_peak, "certified": certified})
     if track == "flexible" and sys is not None:
-        out.modes += _modes(g.label, label, model, sys, cfg.track_mode_min_hz)
+        out.modes += _modes(g.label, label, model, cfg.track_mode_min_hz)
         out.tracks.append((g.label, vehicle.lumped_track()))
 
 
@@ -271,17 +272,13 @@ def report(result: ForcedResult, writer: Writer) -> str:
     return "\n".join(line for section in SECTIONS for line in section(result)) + "\n"
 
 
-def _modes(group: str, label: str, model, sys, min_hz: float) -> list[dict]:
-    """Damped modes above ``min_hz`` with their three largest coordinates (displacement part of V)."""
-    m = sys.modal()
-    n = sys.n
-    out = []
-    for k in np.flatnonzero((m.s.imag > 0) & (m.s.imag >= min_hz * HZ)):
-        top = np.argsort(-np.abs(m.V[:n, k]))[:3]
-        out.append({"group": group, "model": label, "frequency_hz": m.s[k].imag / HZ,
-                    "damping_ratio": -m.s[k].real / abs(m.s[k]),
-                    "dominant": ", ".join(model.coordinates[i] for i in top)})
-    return sorted(out, key=lambda r: r["frequency_hz"])
+def _modes(group: str, label: str, model, min_hz: float) -> list[dict]:
+    """Modes of the model at its speed above ``min_hz``, named by their kinetic-energy shares
+    (:func:`railopt.models.stability.modes`: "track", "front truck pitch", ...)."""
+    table = modes(model, speed=model.speed)
+    table = table[table["frequency_hz"] >= min_hz]
+    return [{"group": group, "model": label, "frequency_hz": r["frequency_hz"], "damping_ratio": r["damping_ratio"],
+             "name": r["name"], "share": r["share"], "track_share": r["track_share"]} for _, r in table.iterrows()]
 
 
 def _slug(output: str) -> str:
@@ -379,13 +376,13 @@ def _findings_section(r: ForcedResult) -> list[str]:
     return lines + ([r.config.notes.strip(), ""] if r.config.notes else [])
 
 
-def _lumped_track_line(group: str, lt, modes: pd.DataFrame) -> str:
+def _lumped_track_line(group: str, lt, table: pd.DataFrame) -> str:
     f0 = np.sqrt(lt.K_e_pair / lt.m_e_pair) / HZ
     line = (f"Lumped track ({group} models): K_e = {lt.K_e_pair:.4g} N/m, m_e = {lt.m_e_pair:.4g} kg, "
             f"C_e = {lt.C_e_pair:.4g} N·s/m per rail pair; its own frequency f0 = √(K_e/m_e)/2π = {f0:.2f} Hz "
             "(4.35).")
-    if not modes.empty:
-        own = modes[(modes["group"] == group) & modes["dominant"].str.split(",").str[0].str.contains("_track")]
+    if not table.empty:
+        own = table[(table["group"] == group) & (table["name"] == "track")]
         if not own.empty:
             f_lo, f_hi = own["frequency_hz"].min(), own["frequency_hz"].max()
             z_lo, z_hi = own["damping_ratio"].min(), own["damping_ratio"].max()
