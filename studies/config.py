@@ -1,23 +1,32 @@
 """Study configs: loading and validating a study TOML, the one field-error format, the shared bases.
 
-Every error names the offending field (and the file): ``"<field.path>: <what is wrong> (got <value>)"``.
-The config tables of every kind derive from :class:`StrictModel` (unknown keys are errors) or
-:class:`FiniteModel` (NaN and inf refused too); intervals and bands are :data:`Interval` and :data:`BandHz`;
-a method name is a :data:`MethodName`, validated against the design layer's registry.
+Every error is one line naming the file and the offending field once: ``"<file>: <field.path>: <what is wrong>
+(got <value>)"`` (``railopt: error:`` in front on the command line).  The config tables of every kind derive from
+:class:`StrictModel` (unknown keys are errors; strings are never numbers; integers must fit their field) or
+:class:`FiniteModel` (NaN and inf refused too); intervals and bands are :data:`Interval` and :data:`BandHz`; a method
+name is a :data:`MethodName`, validated against the design layer's registry.  Relative paths in a study
+(``vehicle = "car.toml"`` in ``[[models]].options``) are resolved from the study file's folder
+(:func:`resolve_paths`).  :func:`reference_markdown` writes ``docs/config-reference.md`` from the config models.
 """
 
 from __future__ import annotations
 
 import math
+import re
 import tomllib
+import types
+import typing
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator
 
 from railopt.studies.kind import StudyKind, discover_kinds
 
 __all__ = [
+    "INT64_MAX",
+    "INT_LIMITS",
+    "PATH_OPTIONS",
     "BandHz",
     "ConfigError",
     "FiniteModel",
@@ -27,27 +36,51 @@ __all__ = [
     "StudyHeader",
     "field_errors",
     "load_study",
+    "read_toml",
+    "reference_markdown",
     "registered_method",
+    "resolve_paths",
     "study_kind",
 ]
 
 
 class ConfigError(ValueError):
-    """A study config that cannot be used; the message names the field."""
+    """A study config that cannot be used; the message names the file and the field."""
+
+
+_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*(\[\d+\]|\.\d+|\.[A-Za-z_][A-Za-z0-9_\-]*)*$")
+
+
+def _is_path(segment: str) -> bool:
+    return bool(_PATH.match(segment))
+
+
+def _dedupe(text: str) -> str:
+    """``"a: a.b: msg"`` → ``"a.b: msg"``: a field path that the next segment repeats or extends is dropped."""
+    out: list[str] = []
+    for seg in text.split(": "):
+        if out and _is_path(out[-1]) and _is_path(seg) and (
+                seg == out[-1] or seg.startswith((out[-1] + ".", out[-1] + "["))):
+            out[-1] = seg
+        else:
+            out.append(seg)
+    return ": ".join(out)
 
 
 def field_errors(exc: Exception, prefix: str = "") -> str:
-    """Join a pydantic ``ValidationError`` (or any error) into one line naming each field."""
+    """Join a pydantic ``ValidationError`` (or any error) into one line naming each field once.
+
+    ``"<field.path>: <what is wrong> (got <value>)"``; an error of the whole file has no path in front, and a
+    message that starts with its own field's path (or a longer one) does not repeat it."""
     if not isinstance(exc, ValidationError):
-        return f"{prefix}: {exc}" if prefix else str(exc)
+        return _dedupe(f"{prefix}: {exc}" if prefix else str(exc))
     lines = []
     for err in exc.errors():
-        loc = ".".join(str(p) for p in err["loc"])
-        loc = ".".join(p for p in (prefix, loc) if p) or "(top level)"
+        loc = ".".join(p for p in (prefix, ".".join(str(x) for x in err["loc"])) if p)
         msg = err["msg"].removeprefix("Value error, ")
         got = err.get("input")
-        got_text = "" if isinstance(got, dict | list) or err["type"] == "value_error" else f" (got {got!r})"
-        lines.append(f"{loc}: {msg}{got_text}")
+        got_text = "" if isinstance(got, dict | list | tuple) or err["type"] == "value_error" else f" (got {got!r})"
+        lines.append(_dedupe(f"{loc}: {msg}{got_text}" if loc else f"{msg}{got_text}"))
     return "; ".join(lines)
 
 
@@ -88,16 +121,76 @@ MethodName = Annotated[str, AfterValidator(registered_method)]
 """A method name of the design registry; configs never list the methods themselves."""
 
 
-class StrictModel(BaseModel):
-    """Base for config tables: unknown keys and wrong types are errors that name the field."""
+INT64_MAX = 2**63 - 1
+"""The largest integer a study file may hold in an integer field (SQLite and numpy store int64)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+INT_LIMITS: dict[str, int] = {"seed": INT64_MAX, "maxeval": 2**31 - 1, "n_starts": 10**7}
+"""Upper limits of integer fields by name, in every kind: a seed is stored as int64, ``maxeval`` is a C int of
+NLopt, and ``n_starts`` beyond ten million is a slip (the start points alone would not fit in memory)."""
+
+
+def _check_value(annotation: Any, value: Any, name: str, where: str = "") -> Any:
+    """``value`` checked against ``annotation`` before pydantic sees it: a string where a number belongs is
+    refused, an integer beyond its limit too, and TOML arrays become tuples where the annotation is a tuple
+    (strict mode accepts only tuples).  ``where`` is the position inside the field (``"[1]: "``)."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return _check_value(typing.get_args(annotation)[0], value, name, where)
+    if origin in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(annotation) if a is not type(None)]
+        if value is not None and len(args) == 1:
+            return _check_value(args[0], value, name, where)
+        if isinstance(value, str) and args and all(a in (int, float) for a in args):
+            raise ValueError(f"{where}must be a number, not a string (got {value!r})")
+        return value
+    if annotation in (int, float):
+        if isinstance(value, str):
+            raise ValueError(f"{where}must be a number, not a string (got {value!r})")
+        if annotation is int and isinstance(value, int) and not isinstance(value, bool):
+            limit = INT_LIMITS.get(name, INT64_MAX)
+            if value > limit:
+                raise ValueError(f"{where}must be at most {limit} (got an integer of {len(str(value))} digits)")
+            if value < -INT64_MAX - 1:
+                raise ValueError(f"{where}must be at least {-INT64_MAX - 1} (got an integer of "
+                                 f"{len(str(-value))} digits)")
+        return value
+    if origin is tuple and isinstance(value, list | tuple):
+        args = typing.get_args(annotation)
+        if len(args) == 2 and args[1] is Ellipsis:
+            args = (args[0],) * len(value)
+        if len(args) != len(value):
+            return tuple(value)  # pydantic names the wrong length
+        pairs = enumerate(zip(args, value, strict=True))
+        return tuple(_check_value(a, v, name, where or f"[{i}]: ") for i, (a, v) in pairs)
+    if origin is list and isinstance(value, list | tuple):
+        (arg,) = typing.get_args(annotation) or (Any,)
+        return [_check_value(arg, v, name, where or f"[{i}]: ") for i, v in enumerate(value)]
+    if origin is dict and isinstance(value, dict):
+        args = typing.get_args(annotation)
+        arg = args[1] if len(args) == 2 else Any
+        return {k: _check_value(arg, v, name, where or f"{k}: ") for k, v in value.items()}
+    return value
+
+
+class StrictModel(BaseModel):
+    """Base for config tables: unknown keys and wrong types are errors that name the field.
+
+    Strict: a string is never read as a number (``lower = "1e5"`` is refused), nor ``true`` or ``16.0`` as a
+    count; an integer must fit its field (:data:`INT_LIMITS`; int64 at most).  TOML arrays are taken as tuples."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _numbers_and_arrays(cls, value: Any, info: ValidationInfo) -> Any:
+        field = cls.model_fields.get(info.field_name or "")
+        return value if field is None else _check_value(field.annotation, value, info.field_name)
 
 
 class FiniteModel(StrictModel):
     """A config table whose floats must be finite (NaN and inf are refused naming the field)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
 class StudyHeader(StrictModel):
@@ -117,25 +210,227 @@ def study_kind(name: str) -> StudyKind:
     return kinds[name]
 
 
-def load_study(path: str | Path) -> tuple[StudyKind, BaseModel, dict[str, Any]]:
-    """Read, parse and validate a study file; returns its kind, the validated config and the raw dict."""
+_HEADER = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?")
+_KEY = re.compile(r"([A-Za-z0-9_\-]+)\s*=\s*")
+
+
+def _long_integer_key(text: str) -> str | None:
+    """``"table.key"`` (or ``"line N"``) of the first integer literal over Python's int-string digit limit."""
+    table = ""
+    for n, line in enumerate(text.splitlines(), start=1):
+        header = _HEADER.match(line)
+        if header and "=" not in line.split("]")[0]:
+            table = header.group(1).strip().replace('"', "")
+            continue
+        digits = re.search(r"(?<![\w.])[+-]?[0-9][0-9_]{4300,}", line)
+        if digits:
+            keys = [m.group(1) for m in _KEY.finditer(line[:digits.start()])]
+            if not keys:
+                return f"line {n}"
+            return ".".join([table] * bool(table) + keys[:1] + keys[1:][-1:])
+    return None
+
+
+def read_toml(path: str | Path, what: str = "study") -> dict[str, Any]:
+    """The parsed TOML of ``path``; every failure is a :class:`ConfigError` ``"<file>: <what is wrong>"``."""
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"study: no such file {path}")
     try:
-        raw = tomllib.loads(path.read_bytes().decode("utf-8"))
+        data = path.read_bytes()
     except OSError as exc:
-        raise ConfigError(f"{path}: cannot read the study file ({exc.strerror})") from None
+        raise ConfigError(f"{path}: cannot read the {what} file ({exc.strerror})") from None
+    try:
+        text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise ConfigError(f"{path}: not a text file (byte {exc.start} is not UTF-8); a study is a TOML file") from None
+        raise ConfigError(f"{path}: not a text file (byte {exc.start} is not UTF-8); a {what} is a TOML file") \
+            from None
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise ConfigError(f"{path}: not valid TOML (nested too deeply)") from None
+    except ValueError as exc:  # an integer over Python's int-string limit (4300 digits): not a TOMLDecodeError
+        key = _long_integer_key(text)
+        where = f"{key}: " if key else ""
+        limit = "the int-string limit" if "limit" not in str(exc) else str(exc).split(":")[0].strip()
+        raise ConfigError(f"{path}: {where}integer too long to read ({limit}); no field takes a number that large") \
+            from None
+
+
+PATH_OPTIONS: tuple[str, ...] = ("vehicle",)
+"""Options of ``[[models]]`` entries that name a file: resolved from the study file's folder (as are options whose
+names end in ``_file`` or ``_path``)."""
+
+
+def _bundled_vehicles() -> tuple[str, ...]:
+    from railopt.models.vehicle.loader import BUNDLED
+
+    return tuple(BUNDLED)
+
+
+def resolve_paths(raw: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """``raw`` with every relative file path in ``[[models]].options`` resolved against ``folder`` (the study
+    file's): a study means the same files from any working directory.  Absolute paths and bundled vehicle names
+    are kept as they are."""
+    models = raw.get("models")
+    if not isinstance(models, list):
+        return raw
+    bundled = _bundled_vehicles()
+    out = []
+    for entry in models:
+        options = entry.get("options") if isinstance(entry, dict) else None
+        if isinstance(options, dict):
+            options = dict(options)
+            for key, value in options.items():
+                is_path = key in PATH_OPTIONS or key.endswith(("_file", "_path"))
+                if is_path and isinstance(value, str) and value and value not in bundled:
+                    target = Path(value).expanduser()
+                    if not target.is_absolute():
+                        options[key] = str((folder / target).resolve())
+            entry = {**entry, "options": options}
+        out.append(entry)
+    return {**raw, "models": out}
+
+
+def load_study(path: str | Path) -> tuple[StudyKind, BaseModel, dict[str, Any]]:
+    """Read, parse and validate a study file; returns its kind, the validated config and the raw dict (paths
+    resolved).  Every error is a :class:`ConfigError` ``"<file>: <field.path>: <what is wrong>"``."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: study: no such file")
+    raw = read_toml(path)
     header = raw.get("study")
     if not isinstance(header, dict) or "kind" not in header:
-        raise ConfigError(f"study.kind: missing in {path}; every study file needs a [study] table with name and kind")
-    kind = study_kind(str(header["kind"]))
+        raise ConfigError(f"{path}: study.kind: missing; every study file needs a [study] table with name and kind")
+    try:
+        kind = study_kind(str(header["kind"]))
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: {exc}") from None
+    raw = resolve_paths(raw, path.resolve().parent)
     try:
         config = kind.config_model.model_validate(raw)
     except (ValidationError, ValueError) as exc:  # model validators may raise plain ValueError
-        raise ConfigError(field_errors(exc)) from None
+        raise ConfigError(f"{path}: {field_errors(exc)}") from None
     return kind, config, raw
+
+
+# ---------------------------------------------------------------------------------------------- reference
+def _type_name(annotation: Any) -> str:
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return _type_name(typing.get_args(annotation)[0])
+    if origin in (typing.Union, types.UnionType):
+        return " | ".join(_type_name(a) for a in typing.get_args(annotation))
+    if origin is typing.Literal:
+        return " | ".join(f'"{a}"' if isinstance(a, str) else repr(a) for a in typing.get_args(annotation))
+    if origin is tuple:
+        return f"[{', '.join(_type_name(a) for a in typing.get_args(annotation))}]"
+    if origin is list:
+        return f"list of {_type_name(typing.get_args(annotation)[0])}"
+    if origin is dict:
+        key, value = typing.get_args(annotation)
+        return f"table of {_type_name(value)}"
+    if annotation is type(None):
+        return "none"
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return f"[{annotation.__name__}](#{annotation.__name__.lower()})"
+    if annotation is Any:
+        return "any"
+    return getattr(annotation, "__name__", str(annotation))
+
+
+def _nested_models(annotation: Any) -> list[type[BaseModel]]:
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for a in typing.get_args(annotation) for m in _nested_models(a)]
+
+
+def _default_text(field: Any) -> str:
+    if field.is_required():
+        return "required"
+    value = field.default_factory() if field.default_factory is not None else field.default
+    if isinstance(value, BaseModel):
+        return "(table defaults)"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, bool):
+        return str(value).lower()
+    if value is None:
+        return "—"
+    if isinstance(value, tuple):
+        value = list(value)
+    return str(value).replace("'", '"')
+
+
+def _constraints(field: Any) -> str:
+    parts = []
+    for meta in field.metadata:
+        for attr, sign in (("gt", ">"), ("ge", "≥"), ("lt", "<"), ("le", "≤"), ("min_length", "min length"),
+                           ("pattern", "pattern")):
+            value = getattr(meta, attr, None)
+            if value is not None:
+                parts.append(f"{sign} {value}")
+    return ", ".join(parts)
+
+
+def _model_section(model: type[BaseModel], title: str) -> list[str]:
+    doc = (model.__doc__ or "").strip().split("\n\n")[0].replace("\n", " ")
+    doc = " ".join(doc.split())
+    lines = [f"### {title}", ""]
+    if doc and not doc.startswith(("Usage docs:", "A base class")):
+        lines += [doc, ""]
+    lines += ["| field | type | default | description |", "|---|---|---|---|"]
+    for name, field in model.model_fields.items():
+        desc = " ".join((field.description or "").split())
+        limits = _constraints(field)
+        if limits:
+            desc = f"{desc} ({limits})" if desc else limits
+        if name in INT_LIMITS and field.annotation is int:
+            desc = f"{desc}; at most {INT_LIMITS[name]}".lstrip("; ")
+        cells = [f"`{name}`", _type_name(field.annotation), _default_text(field), desc]
+        lines.append("| " + " | ".join(c.replace("|", "\\|") if i != 1 else c.replace(" | ", " or ")
+                                       for i, c in enumerate(cells)) + " |")
+    return lines + [""]
+
+
+def reference_markdown() -> str:
+    """``docs/config-reference.md``: every registered kind's config tables and every catalog model's options,
+    each field with its type, default and description, generated from the pydantic models.
+
+    Regenerate with ``railopt reference --out docs/config-reference.md`` (a test fails when the file is stale)."""
+    from railopt.studies.catalog import discover_models
+
+    lines = ["# Study config reference", "",
+             "Generated from the config models by `railopt reference --out docs/config-reference.md`; do not edit "
+             "by hand (a test compares this file with the models). How to write a study: "
+             "[studies.md](studies.md); a first example: [tutorial.md](tutorial.md).", "",
+             "Every table refuses unknown keys; numbers are numbers (a string such as `\"1e5\"` is refused), counts "
+             "are integers, integers fit int64 (`seed`), `maxeval` fits a C int (at most 2147483647) and `n_starts` "
+             "is at most 10000000. Relative file paths in `[[models]].options` (`vehicle = \"car.toml\"`) are read "
+             "from the study file's folder.", ""]
+    lines += ["## Kinds", ""]
+    for name, kind in sorted(discover_kinds().items()):
+        lines += [f"## Kind `{name}`", ""]
+        if kind.summary:
+            lines += [kind.summary, ""]
+        seen: set[type[BaseModel]] = set()
+        todo = [kind.config_model]
+        while todo:
+            model = todo.pop(0)
+            if model in seen:
+                continue
+            seen.add(model)
+            title = f"`{name}`: the study file ({model.__name__})" if model is kind.config_model else model.__name__
+            lines += _model_section(model, title)
+            for field in model.model_fields.values():
+                todo += [m for m in _nested_models(field.annotation) if m not in seen]
+    lines += ["## Catalog models (`[[models]]` `model = ...`, their `options`)", ""]
+    for name, entry in sorted(discover_models().items()):
+        lines += [f"## Model `{name}`", ""]
+        if entry.description:
+            lines += [entry.description, ""]
+        lines += _model_section(entry.options, f"`{name}` options ({entry.options.__name__})")
+        nested = [m for f in entry.options.model_fields.values() for m in _nested_models(f.annotation)]
+        for model in dict.fromkeys(nested):
+            lines += _model_section(model, model.__name__)
+    return "\n".join(lines).rstrip() + "\n"

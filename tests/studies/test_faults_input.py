@@ -71,7 +71,7 @@ def test_validate_rejects_what_is_not_a_count_naming_the_field(old, new, field, 
     path.write_text(text.replace(old, new))
     assert main(["validate", str(path)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"railopt: error: {field}:"), err
+    assert err.startswith(f"railopt: error: {path}: {field}:") and err.count("\n") == 1, err
 
 
 def test_solver_options_accept_numpy_numbers_and_refuse_bools():
