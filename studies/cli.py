@@ -1,4 +1,9 @@
-"""The ``railopt`` command: run studies, list them, benchmark the hot paths.
+"""The ``railopt`` command: run and validate studies, summarise vehicles, list studies, benchmark the hot paths.
+
+``railopt validate FILE`` checks a study file or a vehicle file (decided by content: a ``[study]`` table or a
+``[vehicle]`` table); ``railopt vehicle NAME_OR_FILE`` prints a vehicle's summary; ``railopt reference`` writes the
+config reference (``docs/config-reference.md``).  Errors are one line ``railopt: error: FILE: field.path: message``;
+warnings (things a study does not refuse but a user must hear of) ``railopt: warning: FILE: message``.
 
 ``railopt run studies/<name>.toml [--workers N] [--scheduler ADDR] [--resume]`` validates the
 config (errors name the field, exit code 2, nothing written), takes the study's lock, runs the
@@ -20,8 +25,8 @@ from pathlib import Path
 
 from railopt import __version__
 from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV, scheduler_timeout
-from railopt.studies.config import ConfigError, load_study
-from railopt.studies.kind import StudyContext
+from railopt.studies.config import ConfigError, load_study, read_toml, reference_markdown
+from railopt.studies.kind import StudyContext, StudyKind
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.publish import (
     CAMPAIGNS,
@@ -36,7 +41,7 @@ from railopt.studies.output.publish import (
 )
 from railopt.studies.output.writer import Writer
 
-__all__ = ["STUDIES_DIR", "build_parser", "main", "resolve_study"]
+__all__ = ["STUDIES_DIR", "build_parser", "main", "print_warnings", "resolve_study"]
 
 STUDIES_DIR = Path(__file__).resolve().parent
 EXIT_USAGE = 2
@@ -53,7 +58,15 @@ def resolve_study(arg: str) -> Path:
     for candidate in (STUDIES_DIR / arg, STUDIES_DIR / f"{arg}.toml"):
         if candidate.is_file():
             return candidate
-    raise ConfigError(f"study: no such file {arg!r} (and no bundled study of that name; see `railopt list`)")
+    raise ConfigError(f"{arg}: study: no such file (and no bundled study of that name; see `railopt list`)")
+
+
+def print_warnings(kind: StudyKind, config: object, study_file: Path | str) -> list[str]:
+    """Print the kind's warnings on ``config`` as ``railopt: warning: FILE: message`` (stderr); returns them."""
+    messages = list(kind.warnings(config)) if kind.warnings is not None else []
+    for message in messages:
+        print(f"railopt: warning: {study_file}: {' '.join(str(message).split())}", file=sys.stderr)
+    return messages
 
 
 def _check_flags(args: argparse.Namespace) -> None:
@@ -77,6 +90,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     study_file = resolve_study(args.study)
     kind, config, _ = load_study(study_file)
     _check_flags(args)
+    print_warnings(kind, config, study_file)
     name = config.study.name
     results = ensure_folder(Path(args.results))
     final = results / name
@@ -125,9 +139,59 @@ def cmd_list(args: argparse.Namespace) -> int:
     return 0
 
 
+def _vehicle_names() -> tuple[str, ...]:
+    from railopt.models.vehicle.loader import BUNDLED
+
+    return tuple(BUNDLED)
+
+
+def _hook_output(text: str, code: int) -> int:
+    """Print a hook's text: stdout when it succeeded, stderr (one line for an error) otherwise."""
+    stream = sys.stdout if code == 0 else sys.stderr
+    print(text.rstrip("\n"), file=stream)
+    return code
+
+
 def cmd_validate(args: argparse.Namespace) -> int:
-    kind, config, _ = load_study(resolve_study(args.study))
+    path = Path(args.study)
+    if not path.is_file() and args.study in _vehicle_names():
+        return _validate_vehicle(args.study)
+    study_file = resolve_study(args.study)
+    raw = read_toml(study_file, "study or vehicle")
+    if "study" not in raw and "vehicle" in raw:
+        return _validate_vehicle(str(study_file))
+    if "study" not in raw:
+        raise ConfigError(f"{study_file}: neither a study file (no [study] table with name and kind) nor a vehicle "
+                          "file (no [vehicle] table)")
+    kind, config, _ = load_study(study_file)
+    print_warnings(kind, config, study_file)
     print(f"{args.study}: valid {kind.name} study '{config.study.name}'")
+    return 0
+
+
+def _validate_vehicle(path: str) -> int:
+    from railopt.models.vehicle.summary import main_validate_vehicle
+
+    return _hook_output(*main_validate_vehicle(path))
+
+
+def cmd_vehicle(args: argparse.Namespace) -> int:
+    from railopt.models.vehicle.summary import main_vehicle
+
+    return _hook_output(*main_vehicle(args.argv))
+
+
+def cmd_reference(args: argparse.Namespace) -> int:
+    text = reference_markdown()
+    if args.out is None:
+        sys.stdout.write(text)
+        return 0
+    out = Path(args.out)
+    try:
+        out.write_text(text)
+    except OSError as exc:
+        raise ResultsError(f"{out}: cannot write the reference ({exc.strerror or exc})") from None
+    print(f"written {out}")
     return 0
 
 
@@ -163,9 +227,19 @@ def build_parser() -> argparse.ArgumentParser:
     lst = sub.add_parser("list", help="list the bundled studies")
     lst.set_defaults(func=cmd_list)
 
-    val = sub.add_parser("validate", help="validate a study config without running it")
-    val.add_argument("study")
+    val = sub.add_parser("validate", help="validate a study file or a vehicle file without running it")
+    val.add_argument("study", help="a study TOML ([study] table), a vehicle TOML ([vehicle] table), or a bundled name")
     val.set_defaults(func=cmd_validate)
+
+    veh = sub.add_parser("vehicle", add_help=False,
+                         help="summary of a vehicle: railopt vehicle NAME_OR_FILE [--speed S] "
+                              "[--track rigid|flexible] [--markdown]")
+    veh.add_argument("argv", nargs=argparse.REMAINDER)
+    veh.set_defaults(func=cmd_vehicle)
+
+    ref = sub.add_parser("reference", help="the config reference (Markdown) of every kind and catalog model")
+    ref.add_argument("--out", default=None, help="write it to this file (default: stdout)")
+    ref.set_defaults(func=cmd_reference)
 
     bench = sub.add_parser("bench", help="benchmarks, printed as ratios; written to results/benchmarks/")
     bench.add_argument("--out", default="results/benchmarks")

@@ -5,14 +5,12 @@ but the campaign stores."""
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from tqdm import tqdm
 
 from railopt.design import CampaignStore, MinimaxProblem, check_designs, distinct_optima, multistart
 from railopt.models.stability import root_locus
@@ -71,17 +69,13 @@ def run_campaign(
         store = CampaignStore.open(path, expect_config=config)
     else:
         store = CampaignStore.create(path, label, config, list(problem.space.names))
-    bar = tqdm(desc=label, unit="start", file=sys.stderr, disable=not context.show_progress, mininterval=0.5)
+    from railopt.studies.output.progress import Progress  # a bar on a terminal, plain periodic lines in a log
 
-    def progress(done: int, total: int) -> None:
-        bar.total = total
-        bar.n = done
-        bar.refresh()
-
+    bar = Progress(label, unit="start", enabled=context.show_progress)
     try:
         return multistart(problem, settings.n_starts, method=settings.method, seed=settings.seed,
                           sampler=settings.sampler, points=points, client=client, store=store,
-                          options=settings.solver_options(), progress=progress)
+                          options=settings.solver_options(), progress=bar.update)
     finally:
         bar.close()
         store.close()
