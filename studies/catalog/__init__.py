@@ -213,6 +213,11 @@ class ModelSetup:
         The speed (m/s) up to which a design must not hunt (the hunting check's maximum operating speed).
     limits : mapping name -> float
         Named limits of the model's outputs (the vehicle file's ``[clearances]``, m), for constraints.
+    units : mapping output -> str
+        The unit of each output (``"m/s²"``, ``"rad"``), per the input below; figure axes and tables.
+    input_label : str
+        The input the outputs are per (``"6.35 mm (0.25 in) lateral irregularity"``); empty when unforced or
+        per unit force.
     """
 
     family: ParametricSystem
@@ -223,6 +228,18 @@ class ModelSetup:
     description: str = ""
     required_speed: float | None = None
     limits: dict[str, float] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+    input_label: str = ""
+
+    def axis_label(self, output: str, inch: bool = False) -> str:
+        """An axis label naming the output, its unit and the input it is per:
+        ``"|cab_acceleration| (m/s² per 6.35 mm (0.25 in) lateral irregularity)"``; ``inch``: metres shown as
+        inches (``in/s²``)."""
+        unit = self.units.get(output, "")
+        if inch and (unit == "m" or unit.startswith("m/")):
+            unit = "in" + unit[1:]
+        parts = [p for p in (unit, f"per {self.input_label}" if self.input_label else "") if p]
+        return f"|{output}| ({' '.join(parts)})" if parts else f"|H| of {output}"
 
     @property
     def defaults(self) -> np.ndarray:

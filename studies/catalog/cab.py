@@ -48,5 +48,12 @@ def cab_lateral_setup(options: CabOptions) -> ModelSetup:
     else:
         description = f"{vehicle.name} cab model, S = {options.max_speed_mph:g} mph"
     search = (options.critical_search_mph[0] * MPH, options.critical_search_mph[1] * MPH)
-    return vehicle_setup(vehicle, family, description, ("rigid", "flexible"), search,
-                         options.max_operating_speed_mph * MPH, abscissa=family)
+    setup = vehicle_setup(vehicle, family, description, ("rigid", "flexible"), search,
+                          options.max_operating_speed_mph * MPH, abscissa=family)
+    suffix = {"displacement": "", "velocity": "/s", "acceleration": "/s²"}
+    system = family.at()
+    setup.units = {o: ("rad" if o == "body_roll" else "m") + suffix[system.outputs[o].quantity]
+                   for o in family.output_names}
+    amplitude_mm = options.amplitude_in * INCH * 1000
+    setup.input_label = f"{amplitude_mm:.3g} mm ({options.amplitude_in:g} in) lateral irregularity"
+    return setup

@@ -48,4 +48,5 @@ def tmd_setup(options: TMDOptions) -> ModelSetup:
         },
         checks={"spectral_abscissa": AbscissaCheck(family)},
         description=f"TMD, μ = {mu:g}, m1 = {m1:g} kg, f1 = {options.primary_frequency_hz:g} Hz",
+        units={"amplification": "k1·x1 / F, dimensionless"},
     )

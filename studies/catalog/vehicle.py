@@ -15,6 +15,7 @@ from pydantic import Field
 
 from railopt.models import ParametricSystem
 from railopt.models.vehicle import load_vehicle
+from railopt.models.vehicle.outputs import UNIT_SUFFIX, output_rows
 from railopt.studies.catalog import (
     AbscissaCheck,
     HuntingCheck,
@@ -208,5 +209,8 @@ def vehicle_forced_setup(options: VehicleForcedOptions) -> ModelSetup:
     family = model.family(names, input=irregularity, outputs=options.outputs, quantity=options.quantity)
     description = (f"{model.name}, {options.view}, {options.track} track, S = {options.speed_m_s:g} m/s, "
                    f"{irregularity.label}")
-    return vehicle_setup(vehicle, family, description, [options.track], *options.hunting(options.speed_m_s),
-                         abscissa=model.family(names))
+    setup = vehicle_setup(vehicle, family, description, [options.track], *options.hunting(options.speed_m_s),
+                          abscissa=model.family(names))
+    setup.units = {r.name: r.unit + UNIT_SUFFIX[options.quantity] for r in output_rows(model, options.outputs)}
+    setup.input_label = f"{options.input.amplitude_m * 1000:.4g} mm {options.input.kind} irregularity"
+    return setup

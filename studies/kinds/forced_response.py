@@ -148,6 +148,7 @@ class FigureSpec:
     peaks: dict
     note: str
     log_frequency: bool
+    input_label: str = ""
 
 
 @dataclass(frozen=True)
@@ -238,7 +239,7 @@ def _curves_and_figures(g: GroupSpec, models: dict, out: _Group) -> tuple[list[p
                 figures.append(FigureSpec(f"{g.label}_{_slug(p.output)}_{b.label}", g.label, p, b.label, rows,
                                           f"{p.figure} {p.title}".strip(),
                                           {t: out.peak_at[(t, b.label, p.output)] for t in TRACKS},
-                                          _note(models, b, g), b.spacing == "log"))
+                                          _note(models, b, g), b.spacing == "log", _input_label(models)))
     return curves, figures
 
 
@@ -263,7 +264,8 @@ def compute(config: ForcedResponseConfig, context: StudyContext) -> ForcedResult
 def report(result: ForcedResult, writer: Writer) -> str:
     cfg = result.config
     for f in result.figures:
-        fig = plot_forced_response(f.series, title=f.title, peaks=f.peaks, note=f.note, log_frequency=f.log_frequency)
+        fig = plot_forced_response(f.series, title=f.title, peaks=f.peaks, note=f.note, log_frequency=f.log_frequency,
+                                   input_label=f.input_label)
         writer.figure(fig, f.name, dpi=cfg.dpi)
     writer.table(result.frf, "frf")
     writer.table(result.table, "peaks")
@@ -279,6 +281,12 @@ def _modes(group: str, label: str, model, min_hz: float) -> list[dict]:
     table = table[table["frequency_hz"] >= min_hz]
     return [{"group": group, "model": label, "frequency_hz": r["frequency_hz"], "damping_ratio": r["damping_ratio"],
              "name": r["name"], "share": r["share"], "track_share": r["track_share"]} for _, r in table.iterrows()]
+
+
+def _input_label(models: dict) -> str:
+    """The irregularity the amplitudes are per: ``"6.35 mm vertical irregularity"``."""
+    irr = models["rigid"][4]
+    return f"{irr.amplitude_m * 1000:.4g} mm {irr.kind} irregularity"
 
 
 def _slug(output: str) -> str:

@@ -122,7 +122,7 @@ def _model_curves(cfg: FRFStudyConfig, i: int, ref, f_hz: np.ndarray, band: tupl
                           "grid_points": rm.grid_points, "evaluation": rm.evaluation})
             panel_curves[o].append((f"{d.label} (peak {rm.value:.6g} at {rm.argmax_frequency / HZ:.4g} Hz)",
                                     f_hz, np.abs(h), f"C{j}"))
-    panels = [(f"{ref.label}: {setup.description}", f"|H| of {o}", c) for o, c in panel_curves.items()]
+    panels = [(f"{ref.label}: {setup.description}", setup.axis_label(o), c) for o, c in panel_curves.items()]
     return curves, peaks, panels
 
 

@@ -7,6 +7,7 @@ the wheel), distance along the track with the load at 0, ahead to the right.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -58,6 +59,38 @@ def _caption(fig: Figure, note: str) -> None:
         fig.tight_layout(rect=(0.0, 0.07, 1.0, 1.0))
     else:
         fig.tight_layout()
+
+
+def wrap_title(text: str, width_in: float, fontsize: float) -> str:
+    """``text`` wrapped to lines that fit ``width_in`` inches at ``fontsize`` points (about 0.55 em a character)."""
+    width = max(16, int(width_in * 72.0 / (0.55 * fontsize)))
+    return "\n".join(textwrap.fill(part, width, break_on_hyphens=False) for part in text.split("\n"))
+
+
+LINE_STYLES = ("-", "--", "-.", ":")
+
+
+class StylePicker:
+    """Distinct (colour, line style) pairs within one panel: a preferred pair when it is free, else the same colour
+    with the next line style, else the next free pair of matplotlib's cycle."""
+
+    def __init__(self) -> None:
+        self.used: set[tuple[str, str]] = set()
+
+    def take(self, color: str, ls: str = "-") -> tuple[str, str]:
+        candidates = [(color, ls)] + [(color, x) for x in LINE_STYLES] + \
+                     [(f"C{i}", x) for x in LINE_STYLES for i in range(10)]
+        for pair in candidates:
+            if pair not in self.used:
+                self.used.add(pair)
+                return pair
+        return color, ls
+
+
+def _band_edge(values: np.ndarray) -> str:
+    """", band edge" when the largest value lies at the first or last frequency (the curve still rising)."""
+    k = int(np.argmax(values))
+    return ", band edge" if k in (0, len(values) - 1) else ""
 
 
 def plot_profiles(curves: Sequence[Curve], title: str, units: str = "inch-pound", note: str = "") -> Figure:
@@ -154,56 +187,105 @@ def plot_frf_panels(panels: Sequence[tuple[str, str, Sequence[tuple[str, np.ndar
     """One panel per (title, y label, curves); a curve is (label, frequency in Hz, |H|, style key).
 
     Style keys: ``"ref"`` (named designs: wide grey), ``"exact"``, ``"thesis"`` (optima of the two
-    objectives); any other key cycles through matplotlib's colours.
+    objectives); any other key cycles through matplotlib's colours.  No two curves of a panel share colour and
+    line style (a repeated key takes its colour's next line style).  Titles are wrapped to the panel's width;
+    the y label should name the quantity, its unit and the input amplitude (``ModelSetup.axis_label``).
     """
-    fig = Figure(figsize=(6.2 * len(panels), 4.3))
+    width = 6.2
+    fig = Figure(figsize=(width * len(panels), 4.6))
     axes = fig.subplots(1, len(panels), squeeze=False)[0]
     for ax, (title, ylabel, curves) in zip(axes, panels, strict=True):
+        styles = StylePicker()
         for i, (label, f_hz, mag, key) in enumerate(curves):
-            color, ls, lw, alpha = FRF_STYLES.get(key, (f"C{i % 10}", "-", 1.2, 1.0))
+            color, ls, lw, alpha = FRF_STYLES.get(key, (f"C{i % 10}", LINE_STYLES[i % len(LINE_STYLES)], 1.4, 1.0))
+            color, ls = styles.take(color, ls)
             ax.plot(f_hz, mag, color=color, ls=ls, lw=lw, alpha=alpha, label=label)
-        ax.set_title(title, fontsize=9)
+        ax.set_title(wrap_title(title, width - 1.2, 9), fontsize=9)
         ax.set_xlabel("forcing frequency (Hz)")
-        ax.set_ylabel(ylabel)
+        ax.set_ylabel(wrap_title(ylabel, 3.8, 9), fontsize=9)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     fig.tight_layout()
     return fig
 
 
-def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame) -> Figure:
-    """Fig 4.4 style: roots in the complex plane coloured by speed, one panel per model; and the
-    least damping ratio against speed."""
-    models = list(dict.fromkeys(locus["model"]))
-    ncols = min(3, len(models) + 1)
-    nrows = -(-(len(models) + 1) // ncols)
-    fig = Figure(figsize=(5.4 * ncols, 4.2 * nrows))
-    axes = list(fig.subplots(nrows, ncols, squeeze=False).ravel())
-    for extra in axes[len(models) + 1:]:
-        extra.set_visible(False)
-    axes = axes[: len(models) + 1]
-    for ax, m in zip(axes, models, strict=False):
-        d = locus[(locus["model"] == m) & (locus["frequency_hz"] < 25)]
-        sc = ax.scatter(d["real"], d["frequency_hz"], c=d["speed"], s=3, cmap="viridis")
-        ax.axvline(0.0, color="k", lw=0.8)
-        cs = critical[critical["model"] == m].iloc[0]
-        ax.set_title(f"{m}: critical {cs['critical_speed_m_s']:.2f} m/s ({cs['critical_speed_mph']:.1f} mph)",
-                     fontsize=9)
-        ax.set_xlabel("Re s (1/s)")
-        ax.set_ylabel("Im s / 2π (Hz)")
-        ax.set_xlim(max(d["real"].min(), -15.0), max(d["real"].max() * 1.2, 1.0))
+def _upper_roots(d: pd.DataFrame) -> pd.DataFrame:
+    """One root of each complex pair (Im s ≥ 0) and the real roots."""
+    return d[d["imag"] >= 0] if "imag" in d else d
+
+
+def _off_chart(d: pd.DataFrame, max_hz: float) -> int:
+    """The most roots above ``max_hz`` at any one speed (one per complex pair)."""
+    above = _upper_roots(d)
+    above = above[above["frequency_hz"] > max_hz]
+    return int(above.groupby("speed").size().max()) if len(above) else 0
+
+
+def _below(d: pd.DataFrame, max_hz: float) -> pd.DataFrame:
+    up = _upper_roots(d)
+    return up[up["frequency_hz"] <= max_hz]
+
+
+def _locus_panels(ax_z, ax_f, d: pd.DataFrame, max_hz: float, color: str, marker: str, label: str) -> None:
+    """Damping ratio (top) and frequency (bottom) of the roots below ``max_hz`` against speed."""
+    shown = _below(d, max_hz)
+    kw = {"ls": "none", "marker": marker, "ms": 2.2, "color": color, "label": label}
+    ax_z.plot(shown["speed"], shown["damping_ratio"], **kw)
+    ax_f.plot(shown["speed"], shown["frequency_hz"], **kw)
+
+
+def _locus_axes(ax_z, ax_f, max_hz: float, shown: pd.DataFrame) -> None:
+    ax_z.axhline(0.0, color="k", lw=0.8)
+    ax_z.set_ylabel("damping ratio ζ = −Re s / |s|")
+    ax_f.set_ylabel("frequency |Im s| / 2π (Hz)")
+    ax_f.set_xlabel("forward speed (m/s)")
+    top = float(shown["frequency_hz"].max()) if len(shown) else max_hz
+    ax_f.set_ylim(0.0, min(max_hz, 1.08 * top) if top > 0 else max_hz)
+    low = float(shown["damping_ratio"].min()) if len(shown) else 0.0
+    ax_z.set_ylim(min(-0.05, 1.1 * low), 1.05)
+    for ax in (ax_z, ax_f):
         ax.grid(alpha=0.3)
-        fig.colorbar(sc, ax=ax, label="speed (m/s)")
-    ax = axes[-1]
-    for m in models:
-        g = locus[locus["model"] == m].groupby("speed")["damping_ratio"].min()
-        ax.plot(g.index, g.to_numpy(), label=m)
-    ax.axhline(0.0, color="k", lw=0.8)
-    ax.set_xlabel("speed (m/s)")
-    ax.set_ylabel("least damping ratio")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
+
+
+def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame, max_hz: float = 25.0) -> Figure:
+    """Velocity root loci in the rail convention: per model, the damping ratio (top) and the frequency (bottom,
+    Hz) of each root against forward speed, sharing the speed axis; roots with ζ < 0 (hunting) in red, the
+    critical speed dashed.  Roots above ``max_hz`` (track modes) are not drawn; each model's panel and the
+    caption say how many.
+    """
+    models = list(dict.fromkeys(locus["model"]))
+    ncols = min(2, len(models))
+    mrows = -(-len(models) // ncols)
+    width = 6.0
+    fig = Figure(figsize=(width * ncols, 6.4 * mrows))
+    axes = fig.subplots(2 * mrows, ncols, squeeze=False, sharex="col")
+    notes = []
+    for k, m in enumerate(models):
+        ax_z, ax_f = axes[2 * (k // ncols), k % ncols], axes[2 * (k // ncols) + 1, k % ncols]
+        d = locus[locus["model"] == m]
+        _locus_panels(ax_z, ax_f, d[d["damping_ratio"] >= 0], max_hz, "C0", "o", "roots, ζ ≥ 0")
+        if (d["damping_ratio"] < 0).any():
+            _locus_panels(ax_z, ax_f, d[d["damping_ratio"] < 0], max_hz, "C3", "o", "roots, ζ < 0")
+        cs = critical[critical["model"] == m].iloc[0]
+        title = f"{m}: critical speed {cs['critical_speed_m_s']:.2f} m/s ({cs['critical_speed_mph']:.1f} mph)"
+        if isinstance(cs.get("mode"), str):
+            title += f", {cs['mode']}"
+        if np.isfinite(cs["critical_speed_m_s"]):
+            for ax in (ax_z, ax_f):
+                ax.axvline(cs["critical_speed_m_s"], color="k", ls="--", lw=0.9,
+                           label="critical speed" if ax is ax_z else None)
+        _locus_axes(ax_z, ax_f, max_hz, _below(d, max_hz))
+        ax_z.set_title(wrap_title(title, width - 1.0, 9), fontsize=9)
+        ax_z.legend(fontsize=7, markerscale=3, loc="lower left")
+        hidden = _off_chart(d, max_hz)
+        if hidden:
+            text = f"{hidden} roots above {max_hz:g} Hz not shown"
+            ax_f.text(0.01, 0.98, text, transform=ax_f.transAxes, va="top", ha="left", fontsize=7, color="0.3")
+            notes.append(f"{m}: {text}")
+    for k in range(len(models), mrows * ncols):
+        axes[2 * (k // ncols), k % ncols].set_visible(False)
+        axes[2 * (k // ncols) + 1, k % ncols].set_visible(False)
+    _caption(fig, wrap_title("; ".join(notes), width * ncols - 0.5, 7))
     return fig
 
 
@@ -213,7 +295,7 @@ TRACK_STYLES = {"rigid": ("C0", "-", 1.4), "flexible": ("C3", "--", 1.4)}
 
 def plot_forced_response(series: dict[str, pd.DataFrame], title: str,
                          peaks: dict[str, tuple[float, float]] | None = None, note: str = "",
-                         log_frequency: bool = False) -> Figure:
+                         log_frequency: bool = False, input_label: str = "") -> Figure:
     """Figs 4.5–4.12 style: amplitude of one output against the forcing frequency, rigid and flexible
     track on the same axes (the thesis plots amplitudes only).
 
@@ -229,12 +311,17 @@ def plot_forced_response(series: dict[str, pd.DataFrame], title: str,
         Caption (model, speed, irregularity).
     log_frequency : bool
         Logarithmic frequency axis.
+    input_label : str
+        The input the amplitudes are per (``"6.35 mm vertical irregularity"``), named on the y axis.
     """
-    fig = Figure(figsize=(7.0, 4.4))
+    width = 7.0
+    fig = Figure(figsize=(width, 4.6))
     ax = fig.subplots()
     unit = output = ""
+    styles = StylePicker()
     for track, d in series.items():
         color, ls, lw = TRACK_STYLES.get(track, ("k", "-", 1.2))
+        color, ls = styles.take(color, ls)
         label = f"{track} track"
         if peaks and track in peaks:
             value, f_peak = peaks[track]
@@ -242,49 +329,58 @@ def plot_forced_response(series: dict[str, pd.DataFrame], title: str,
             ax.plot([f_peak], [value], marker="v", color=color, ms=5, ls="none")
         ax.plot(d["frequency_hz"], d["amplitude"], color=color, ls=ls, lw=lw, label=label)
         unit, output = d["unit"].iloc[0], d["output"].iloc[0]
-    ax.set_ylabel(f"|{output}| ({unit})")
+    per = f" per {input_label}" if input_label else ""
+    ax.set_ylabel(wrap_title(f"|{output}| ({unit}{per})", 3.6, 9), fontsize=9)
     ax.set_xlabel("forcing frequency f = S/L (Hz)")
     if log_frequency:
         ax.set_xscale("log")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(wrap_title(title, width - 1.0, 10), fontsize=10)
     ax.set_ylim(bottom=0.0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    _caption(fig, note)
+    _caption(fig, wrap_title(note, width - 0.4, 7))
     return fig
 
 
 def plot_before_after(f_hz: np.ndarray, before: np.ndarray, after: np.ndarray, title: str, ylabel: str) -> Figure:
-    """An output's |H| before and after optimisation against frequency (Figs 4.13–4.16)."""
-    fig = Figure(figsize=(7.0, 4.2))
+    """An output's |H| before and after optimisation against frequency (Figs 4.13–4.16).  The legend gives each
+    peak and where it lies ("band edge" when the largest value is at an end of the band: the curve still rising);
+    ``ylabel`` should name the quantity, its unit and the input amplitude (``ModelSetup.axis_label``)."""
+    width = 7.0
+    fig = Figure(figsize=(width, 4.4))
     ax = fig.subplots()
-    ax.plot(f_hz, before, "C3-", lw=1.3, label=f"before (peak {np.max(before):.4g})")
-    ax.plot(f_hz, after, "C0-", lw=1.6, label=f"after (peak {np.max(after):.4g})")
+    for label, values, color, lw in (("before", before, "C3", 1.3), ("after", after, "C0", 1.6)):
+        k = int(np.argmax(values))
+        ax.plot(f_hz, values, color=color, ls="-", lw=lw,
+                label=f"{label} (peak {values[k]:.4g} at {f_hz[k]:.3g} Hz{_band_edge(values)})")
+        ax.plot([f_hz[k]], [values[k]], color=color, marker="v", ls="none", ms=5)
     ax.set_xlabel("forcing frequency (Hz)")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
+    ax.set_ylabel(wrap_title(ylabel, 3.6, 9), fontsize=9)
+    ax.set_title(wrap_title(title, width - 1.0, 10), fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
 
 
-def plot_root_loci_before_after(loci: dict[str, pd.DataFrame], title: str) -> Figure:
-    """Velocity root loci of two designs (Fig 4.17): roots below 25 Hz, coloured by design."""
-    fig = Figure(figsize=(7.0, 4.6))
-    ax = fig.subplots()
-    for (label, d), color in zip(loci.items(), ("C3", "C0"), strict=False):
-        d = d[d["frequency_hz"] < 25]
-        ax.scatter(d["real"], d["frequency_hz"], s=3, color=color, label=label)
-    ax.axvline(0.0, color="k", lw=0.8)
-    top = max(float(d["real"].max()) for d in loci.values())
-    ax.set_xlim(-15.0, max(1.2 * top, 1.0))
-    ax.set_xlabel("Re s (1/s)")
-    ax.set_ylabel("Im s / 2π (Hz)")
-    ax.set_title(title, fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, markerscale=4)
-    fig.tight_layout()
+def plot_root_loci_before_after(loci: dict[str, pd.DataFrame], title: str, max_hz: float = 25.0) -> Figure:
+    """Velocity root loci of two designs (Fig 4.17) in the rail convention: damping ratio (top) and frequency (Hz,
+    bottom) against forward speed, one colour and marker per design; roots above ``max_hz`` are counted in the
+    caption, not drawn."""
+    width = 7.0
+    fig = Figure(figsize=(width, 6.6))
+    ax_z, ax_f = fig.subplots(2, 1, sharex=True)
+    notes = []
+    for (label, d), (color, marker) in zip(loci.items(), (("C3", "o"), ("C0", "^"), ("C2", "s"), ("C4", "D")),
+                                           strict=False):
+        _locus_panels(ax_z, ax_f, d, max_hz, color, marker, label)
+        hidden = _off_chart(d, max_hz)
+        if hidden:
+            notes.append(f"{label}: {hidden} roots above {max_hz:g} Hz not shown")
+    _locus_axes(ax_z, ax_f, max_hz, pd.concat([_below(d, max_hz) for d in loci.values()]))
+    ax_z.set_title(wrap_title(title, width - 1.0, 10), fontsize=10)
+    ax_z.legend(fontsize=8, markerscale=3)
+    _caption(fig, "; ".join(notes))
     return fig
 
 
