@@ -257,7 +257,7 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame, max_hz: float =
     ncols = min(2, len(models))
     mrows = -(-len(models) // ncols)
     width = 6.0
-    fig = Figure(figsize=(width * ncols, 6.4 * mrows))
+    fig = Figure(figsize=(width * ncols, 6.0 * mrows), layout="constrained")
     axes = fig.subplots(2 * mrows, ncols, squeeze=False, sharex="col")
     notes = []
     for k, m in enumerate(models):
@@ -285,7 +285,8 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame, max_hz: float =
     for k in range(len(models), mrows * ncols):
         axes[2 * (k // ncols), k % ncols].set_visible(False)
         axes[2 * (k // ncols) + 1, k % ncols].set_visible(False)
-    _caption(fig, wrap_title("; ".join(notes), width * ncols - 0.5, 7))
+    if notes:  # a caption the constrained layout makes room for
+        fig.supxlabel(wrap_title("; ".join(notes), width * ncols - 0.5, 7), fontsize=7, color="0.3")
     return fig
 
 
