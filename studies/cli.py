@@ -38,6 +38,7 @@ from railopt.studies.output.publish import (
     publish,
     staging_path,
     study_lock,
+    writing,
 )
 from railopt.studies.output.writer import Writer
 
@@ -111,11 +112,12 @@ def cmd_run(args: argparse.Namespace) -> int:
         try:
             result = kind.compute(config, context)
             writer = Writer(staging)
-            (staging / "summary.md").write_text(kind.report(result, writer))
-            shutil.copyfile(study_file, staging / "study.toml")
+            writer.text(kind.report(result, writer), "summary.md")
+            writer.copy(study_file, "study.toml")
             if not args.fresh:
                 carry_stores(final, staging)
-            publish(staging, final)
+            with writing(final):
+                publish(staging, final)
         finally:
             shutil.rmtree(staging, ignore_errors=True)
     with_pd_options = result.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")

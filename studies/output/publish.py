@@ -40,6 +40,8 @@ __all__ = [
     "ensure_folder",
     "lock_path",
     "publish",
+    "write_error",
+    "writing",
     "staging_path",
     "study_lock",
 ]
@@ -62,6 +64,28 @@ def _os_error(exc: OSError, path: Path, doing: str) -> ResultsError:
     else:
         why = exc.strerror or str(exc)
     return ResultsError(f"results: cannot {doing} {where}: {why}; --results must name a writable folder")
+
+
+def write_error(exc: OSError, path: Path | str) -> ResultsError:
+    """A failed write of ``path`` as one line naming it (a failed ``write()`` has no filename of its own):
+    ``results: cannot write <path>: No space left on device; free space or choose another --results``."""
+    where = exc.filename if exc.filename is not None else path
+    why = exc.strerror or str(exc) or type(exc).__name__
+    hint = "free space or choose another --results" if exc.errno in (errno.ENOSPC, errno.EDQUOT) else \
+        "--results must name a writable folder"
+    return ResultsError(f"results: cannot write {where}: {why}; {hint} (the published results are unchanged)")
+
+
+@contextmanager
+def writing(path: Path | str) -> Iterator[None]:
+    """Turn an ``OSError`` raised while writing ``path`` into a :class:`ResultsError` naming it (see
+    :func:`write_error`); the caller's staging folder is removed by the CLI, so nothing half-written remains."""
+    try:
+        yield
+    except ResultsError:
+        raise
+    except OSError as exc:
+        raise write_error(exc, path) from None
 
 
 def ensure_folder(path: Path) -> Path:
@@ -183,10 +207,12 @@ def carry_stores(final: Path, staging: Path) -> None:
     if not source.is_dir():
         return
     target = staging / CAMPAIGNS
-    target.mkdir(exist_ok=True)
+    with writing(target):
+        target.mkdir(exist_ok=True)
     for item in sorted(source.iterdir()):
         if item.is_file() and not item.name.startswith(".") and not (target / item.name).exists():
-            shutil.copy2(item, target / item.name)
+            with writing(target / item.name):
+                shutil.copy2(item, target / item.name)
 
 
 def publish(staging: Path, final: Path) -> None:
