@@ -47,11 +47,19 @@ def affine(base: np.ndarray, parts: np.ndarray, p: np.ndarray) -> np.ndarray:
     ``base`` (…), ``parts`` (P, …), ``p`` (P,).  Used for M, C, K of every family member and for the
     input matrices of vehicle views.
     """
-    acc = np.zeros(np.shape(base), dtype=np.result_type(base, parts))
-    for pi, part in zip(p, parts, strict=True):  # in parameter order: exact cancellations stay exact
-        if pi != 0.0:
-            acc += pi * part
-    return base + acc
+    parts = np.asarray(parts)
+    p = np.asarray(p)
+    if len(p) != len(parts):
+        raise ValueError(f"p: expected {len(parts)} values, got {len(p)}")
+    if parts.dtype == object or len(p) == 0:
+        acc = np.zeros(np.shape(base), dtype=np.result_type(base, parts))
+        for pi, part in zip(p, parts, strict=True):
+            if pi != 0.0:
+                acc += pi * part
+        return base + acc
+    # one reduction over the parameter axis: numpy adds the P products in parameter order (the same sums as
+    # a loop, so exact cancellations stay exact); a zero weight adds only zeros
+    return base + (p.reshape((-1,) + (1,) * (parts.ndim - 1)) * parts).sum(axis=0)
 
 
 def _family_forcing(F: FamilyForcing | None, n: int, field: str) -> Forcing | DistanceForcing | None:

@@ -17,7 +17,7 @@ import numpy as np
 INV_PHI = (np.sqrt(5.0) - 1.0) / 2.0
 BRACKET_RTOL = 1e-6  # stop when the best point is located to this fraction of its bracket (value error ~1e-13)
 MAX_ITERATIONS = 80
-SCALAR_CELLS = 12  # up to this many cells, refine each with the scalar Brent (no numpy overhead per step)
+SCALAR_CELLS = 12  # kept for compatibility: every cell is now refined by the one vectorised Brent
 
 
 def bracketed_maximum(fun: Callable[[np.ndarray], np.ndarray], lower: np.ndarray, upper: np.ndarray,
@@ -29,6 +29,9 @@ def bracketed_maximum(fun: Callable[[np.ndarray], np.ndarray], lower: np.ndarray
     ``fun(x)`` takes one abscissa per still-active bracket.  A bracket stops when its best point is
     located to ``rtol`` times its initial width; the value error of a smooth maximum is then
     ~rtol² relative.  Returns the best point of each bracket and its value.
+
+    All brackets advance together (no loop over brackets); a bracket that has converged is written
+    out and dropped from the working arrays, so each step costs a fixed number of array operations.
     """
     a = np.asarray(lower, dtype=float).copy()
     b = np.asarray(upper, dtype=float).copy()
@@ -37,55 +40,103 @@ def bracketed_maximum(fun: Callable[[np.ndarray], np.ndarray], lower: np.ndarray
     g = 1.0 - INV_PHI  # 0.381966…
     tol1 = np.maximum(rtol * (b - a), 4 * np.finfo(float).eps * np.maximum(np.abs(a), np.abs(b))) / 3.0
     x = a + g * (b - a)
-    w, v = x.copy(), x.copy()
     fx = -fun(x)  # minimise −f
-    fw, fv = fx.copy(), fx.copy()
+    w, v, fw, fv = x.copy(), x.copy(), fx.copy(), fx.copy()
     d = np.zeros_like(a)
     e = np.zeros_like(a)
-    active = np.ones(a.size, dtype=bool)
+    out_x, out_f = x.copy(), fx.copy()
+    where = np.arange(a.size)  # original index of each working bracket
     for _ in range(MAX_ITERATIONS):
         xm = 0.5 * (a + b)
-        tol2 = 2.0 * tol1
-        active &= np.abs(x - xm) > tol2 - 0.5 * (b - a)
-        i = np.flatnonzero(active)
-        if i.size == 0:
-            break
-        ai, bi, xi, wi, vi = a[i], b[i], x[i], w[i], v[i]
-        fxi, fwi, fvi, di, ei, t1, xmi = fx[i], fw[i], fv[i], d[i], e[i], tol1[i], xm[i]
+        keep = np.abs(x - xm) > 2.0 * tol1 - 0.5 * (b - a)
+        if not keep.all():  # write out the converged brackets, drop them from the working set
+            done = ~keep
+            out_x[where[done]], out_f[where[done]] = x[done], fx[done]
+            if not keep.any():
+                break
+            where, a, b, x, w, v, fx, fw, fv, d, e, tol1, xm = (
+                arr[keep] for arr in (where, a, b, x, w, v, fx, fw, fv, d, e, tol1, xm))
         # parabola through (x, w, v)
-        r = (xi - wi) * (fxi - fvi)
-        q = (xi - vi) * (fxi - fwi)
-        p = (xi - vi) * q - (xi - wi) * r
+        r = (x - w) * (fx - fv)
+        q = (x - v) * (fx - fw)
+        p = (x - v) * q - (x - w) * r
         q = 2.0 * (q - r)
         p = np.where(q > 0, -p, p)
         q = np.abs(q)
         with np.errstate(divide="ignore", invalid="ignore"):
-            para = ((np.abs(ei) > t1) & (np.abs(p) < np.abs(0.5 * q * ei))
-                    & (p > q * (ai - xi)) & (p < q * (bi - xi)) & (q != 0))
+            para = ((np.abs(e) > tol1) & (np.abs(p) < np.abs(0.5 * q * e))
+                    & (p > q * (a - x)) & (p < q * (b - x)) & (q != 0))
             dp = np.where(para, p / np.where(q == 0, 1.0, q), 0.0)
-        up = xi + dp
-        near_end = para & (((up - ai) < 2 * t1) | ((bi - up) < 2 * t1))
-        dp = np.where(near_end, np.where(xmi >= xi, t1, -t1), dp)
-        e_gold = np.where(xi >= xmi, ai - xi, bi - xi)
-        new_e = np.where(para, di, e_gold)
+        up = x + dp
+        near_end = para & (((up - a) < 2 * tol1) | ((b - up) < 2 * tol1))
+        dp = np.where(near_end, np.where(xm >= x, tol1, -tol1), dp)
+        e_gold = np.where(x >= xm, a - x, b - x)
+        new_e = np.where(para, d, e_gold)
         new_d = np.where(para, dp, g * e_gold)
-        step = np.where(np.abs(new_d) >= t1, new_d, np.where(new_d >= 0, t1, -t1))
-        u = xi + step
+        step = np.where(np.abs(new_d) >= tol1, new_d, np.where(new_d >= 0, tol1, -tol1))
+        u = x + step
         fu = -fun(u)
-        better = fu <= fxi
+        better = fu <= fx
+        right = u >= x
         # bracket update
-        a[i] = np.where(better, np.where(u >= xi, xi, ai), np.where(u < xi, u, ai))
-        b[i] = np.where(better, np.where(u >= xi, bi, xi), np.where(u < xi, bi, u))
-        take_w = ~better & ((fu <= fwi) | (wi == xi))
-        take_v = ~better & ~take_w & ((fu <= fvi) | (vi == xi) | (vi == wi))
-        v[i] = np.where(better, wi, np.where(take_w, wi, np.where(take_v, u, vi)))
-        fv[i] = np.where(better, fwi, np.where(take_w, fwi, np.where(take_v, fu, fvi)))
-        w[i] = np.where(better, xi, np.where(take_w, u, wi))
-        fw[i] = np.where(better, fxi, np.where(take_w, fu, fwi))
-        x[i] = np.where(better, u, xi)
-        fx[i] = np.where(better, fu, fxi)
-        d[i], e[i] = step, new_e
-    return x, -fx
+        a = np.where(better, np.where(right, x, a), np.where(right, a, u))
+        b = np.where(better, np.where(right, b, x), np.where(right, u, b))
+        take_w = ~better & ((fu <= fw) | (w == x))
+        take_v = ~better & ~take_w & ((fu <= fv) | (v == x) | (v == w))
+        v, fv = np.where(better | take_w, w, np.where(take_v, u, v)), np.where(better | take_w, fw,
+                                                                             np.where(take_v, fu, fv))
+        w, fw = np.where(better, x, np.where(take_w, u, w)), np.where(better, fx, np.where(take_w, fu, fw))
+        x, fx = np.where(better, u, x), np.where(better, fu, fx)
+        d, e = step, new_e
+    else:
+        out_x[where], out_f[where] = x, fx
+    return out_x, -out_f
+
+
+VERTEX_ITERATIONS = 12
+
+
+def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                  rtol: float = BRACKET_RTOL, positive: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Maximiser of ``fun`` in each bracket ``[lower_i, upper_i]`` from its best sample ``x0_i``, all brackets at once.
+
+    Newton steps on the local parabola: each step samples x ± h (one call of ``fun`` for every bracket) and moves
+    to the vertex of the parabola through the three points of φ = 1/f² (``positive``; exactly a parabola near a
+    resonance of one pole, see :func:`cell_maxima`) or of −f, with h the length of the last step (at least
+    10·tol), so the steps contract superlinearly.  A bracket is done when a step is below tol (Brent's
+    ``rtol``·width/3, as in :func:`bracketed_maximum`).  Returns ``(x, ok)``; ``ok`` is False where a step
+    would leave the bracket or the parabola is not convex (the caller refines those by Brent).
+    """
+    lo = np.asarray(lower, dtype=float)
+    hi = np.asarray(upper, dtype=float)
+    x = np.asarray(x0, dtype=float).copy()
+    tol = np.maximum(rtol * (hi - lo), 4 * np.finfo(float).eps * np.maximum(np.abs(lo), np.abs(hi))) / 3.0
+    ok = np.zeros(x.size, dtype=bool)
+    live = np.flatnonzero((x > lo) & (x < hi))  # a best sample on the bracket's end goes to Brent
+    h = 0.5 * np.minimum(x - lo, hi - x)[live]
+    for _ in range(VERTEX_ITERATIONS):
+        if live.size == 0:
+            break
+        xl, a, b = x[live], lo[live], hi[live]
+        left, right = np.maximum(xl - h, a), np.minimum(xl + h, b)
+        k = live.size
+        f = fun(np.concatenate([left, xl, right]))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            phi = 1.0 / (f * f) if positive else -f
+            pl, pm, pr = phi[:k], phi[k:2 * k], phi[2 * k:]
+            dl, dr = xl - left, right - xl
+            num = dl * dl * (pm - pr) - dr * dr * (pm - pl)
+            den = dl * (pr - pm) + dr * (pl - pm)  # > 0: the parabola through the three points is convex
+            step = 0.5 * num / den
+        good = (np.isfinite(phi).reshape(3, k).all(axis=0) & (den > 0) & (dl > 0) & (dr > 0)
+                & (step > a - xl) & (step < b - xl))
+        new = xl + np.where(good, step, 0.0)
+        done = good & (np.abs(step) <= tol[live])
+        ok[live[done]] = True
+        x[live[good]] = new[good]
+        keep = good & ~done
+        live, h = live[keep], np.maximum(np.abs(step[keep]), 10.0 * tol[live[keep]])
+    return x, ok
 
 
 def brent_maximum(fun: Callable[[float], float], lower: float, upper: float,
@@ -160,13 +211,16 @@ def cell_maxima(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, value
         j = int(np.flatnonzero(stop <= start)[0])
         raise ValueError(f"grid: no sample in cell [{bounds[j]:g}, {bounds[j + 1]:g}]; include the boundaries")
     masked = np.where(np.isnan(values), -np.inf, values)
-    order = np.repeat(np.arange(len(start)), stop - start)
-    members = np.concatenate([np.arange(a, b) for a, b in zip(start, stop, strict=True)])
-    cell_max = np.full(len(start), -np.inf)
-    np.maximum.at(cell_max, order, masked[members])
-    hit = masked[members] == cell_max[order]
-    best = np.full(len(start), -1)
-    best[order[hit][::-1]] = members[hit][::-1]  # first sample attaining the cell's maximum
+    # the samples of every cell laid end to end (cells share their boundary samples), then one segmented
+    # reduction per quantity
+    counts = stop - start
+    offsets = np.zeros(len(start), dtype=np.intp)
+    np.cumsum(counts[:-1], out=offsets[1:])
+    members = np.arange(int(counts.sum())) + np.repeat(start - offsets, counts)
+    cell_values = masked[members]
+    cell_max = np.maximum.reduceat(cell_values, offsets)
+    position = np.where(cell_values == np.repeat(cell_max, counts), np.arange(members.size), members.size)
+    best = members[np.minimum.reduceat(position, offsets)]  # first sample attaining the cell's maximum
     x, f = grid[best].copy(), values[best].copy()
     lo_cell, hi_cell = bounds[:-1], bounds[1:]
     lo = np.maximum(grid[np.maximum(best - 1, 0)], lo_cell)
@@ -185,12 +239,10 @@ def cell_maxima(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, value
         # −1/f² has the same maximiser as f > 0 and is exactly a parabola near a resonance of one
         # pole (|H|² ∝ 1/((Ω−ω)² + σ²)), so the parabolic steps converge in a few iterations
         positive = bool(np.all(values[np.isfinite(values)] > 0))
-        if scalar is not None and idx.size <= SCALAR_CELLS:
-            target_s = (lambda w: -1.0 / scalar(w) ** 2) if positive else scalar
-            xr = np.array([brent_maximum(target_s, lo[i], hi[i], rtol)[0] for i in idx])
-        else:
+        xr, ok = vertex_refine(fun, x[idx], lo[idx], hi[idx], rtol, positive)  # every cell at once
+        if not ok.all():  # the safeguard: Brent in the cells where the local parabola did not settle
             target = (lambda w: -1.0 / np.square(fun(w))) if positive else fun
-            xr, _ = bracketed_maximum(target, lo[idx], hi[idx], rtol)
+            xr[~ok], _ = bracketed_maximum(target, lo[idx[~ok]], hi[idx[~ok]], rtol)
         fr = fun(xr)
         better = fr > f[idx]
         x[idx] = np.where(better, xr, x[idx])

@@ -172,10 +172,12 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
     cols = [system.output_index(nm) for nm in names]
     if exact:
         system.modal()  # one eigen-decomposition with vectors serves the roots too
-    wd = system.damped_frequencies()
+    roots = system.eigenvalues()  # one sort serves ω_d, the undamped modes, the growth check and the zero limit
+    modes = roots[1::2]  # = system.mode_roots()
+    wd = np.abs(modes.imag)  # = system.damped_frequencies()
     clipped = np.clip(wd, lo, hi)
     edges = np.array([lo, hi])
-    growing = growing_roots(system.eigenvalues())
+    growing = growing_roots(roots)
     if growing.size:  # no steady state exists: never a silent number
         worst = growing[np.argmax(growing.real)]
         reason = (f"unstable: root s = {worst.real:.6g}{worst.imag:+.6g}i 1/s has Re s > 0, so no steady-state "
@@ -184,14 +186,15 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
         return {nm: ResponseMaxima(np.full(len(freqs), np.inf), freqs, wd, (lo, hi), exact=exact, certified=False,
                                    output=nm, evaluation="unstable", reason=reason) for nm in names}
     # a band from 0 on a system with free rigid-body motion: the lower edge is the limit Ω → 0
-    lo_eval, at_zero = _zero_limit(system, names, cols, hi) if lo == 0.0 else (lo, None)
+    lo_eval, at_zero = _zero_limit(system, names, cols, hi, roots) if lo == 0.0 else (lo, None)
     edges_eval = np.array([lo_eval, hi])
     clipped_eval = np.clip(wd, lo_eval, hi)
     # an undamped mode inside the band has an unbounded peak, whatever rounding makes of Z(ω_d)
-    resonant = system.undamped_modes() & (wd >= lo) & (wd <= hi)
+    undamped = (np.abs(modes.real) <= UNDAMPED_ROOT * np.abs(modes)) & (modes.imag != 0)  # system.undamped_modes()
+    resonant = undamped & (wd >= lo) & (wd <= hi)
     if not exact:
         freqs = np.concatenate([clipped, edges])
-        H = _finite_or_inf(np.abs(system.frf_outputs(omega_rad_s=np.concatenate([clipped_eval, edges_eval]))))
+        H = _finite_or_inf(np.abs(_direct(system, np.concatenate([clipped_eval, edges_eval]))))
         if lo_eval > lo:  # the limit Ω → 0 at the lower edge (and at modes clipped to it)
             H[np.concatenate([clipped_eval, edges_eval]) == lo_eval] = at_zero
         out = {}
@@ -243,7 +246,8 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
 ZERO_STEP = 1.2e-4  # Ω = ZERO_STEP · (least non-neutral |s|) and 2Ω extrapolate H to Ω → 0 when Z(0) is singular
 
 
-def _zero_limit(system: LinearSystem, names: list[str], cols: list[int], hi: float) -> tuple[float, np.ndarray]:
+def _zero_limit(system: LinearSystem, names: list[str], cols: list[int], hi: float,
+                roots: np.ndarray | None = None) -> tuple[float, np.ndarray]:
     """For a band from 0 Hz: ``(lower edge to sample, |H(0)| per output column)``.
 
     Without free rigid-body roots the edge is 0 itself.  With them (s = 0, Z(0) singular) every output must
@@ -252,13 +256,13 @@ def _zero_limit(system: LinearSystem, names: list[str], cols: list[int], hi: flo
     2ε, and the limit is the linear extrapolation 2H(ε) − H(2ε) (error O(ε²)).  An output that grows as Ω → 0
     (the displacement of a free body under a force) is truly unbounded: its band is refused naming ``band``.
     """
-    s = system.eigenvalues()
+    s = system.eigenvalues() if roots is None else roots
     scale = float(np.max(np.abs(s))) if s.size else 0.0
     neutral = np.abs(s) <= NEUTRAL_ROOT * scale
     if scale == 0.0 or not np.any(neutral):
         return 0.0, None
     eps = min(ZERO_STEP * float(np.min(np.abs(s[~neutral]))), 1e-3 * hi)
-    H = system.frf_outputs(omega_rad_s=np.array([eps, 2 * eps, 0.1 * eps]))
+    H = _direct(system, np.array([eps, 2 * eps, 0.1 * eps]))
     mags = np.abs(H)[:, cols]
     growing = ~np.isfinite(mags[2]) | (mags[2] > 1.5 * mags[0] + 1e-300)
     if np.any(growing):
@@ -272,17 +276,17 @@ def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
                  edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool, np.ndarray] | None:
     """Cell maxima (values by direct solves at the refined frequencies) for each output column, and |H| at
     the band edges (the same batch of direct solves)."""
-    sample = (lambda w: system.frf_outputs(omega_rad_s=w)) if pr is None else pr.evaluate
+    sample = (lambda w: _direct(system, w)) if pr is None else pr.evaluate
     mags = _finite_or_inf(np.abs(sample(grid)))
     xs, fs = [], []
-    for c in cols:
-        scalar = None if pr is None else pr.scalar_magnitude(c)
-        x, f = cell_maxima(lambda w, c=c: _finite_or_inf(np.abs(sample(w)[:, c])), grid, mags[:, c], bounds,
-                           scalar=scalar)
+    for c in cols:  # per output (usually one); the cells of each are refined all at once
+        fun = pr.magnitude_function(c) if pr is not None else (
+            lambda w, c=c: _finite_or_inf(np.abs(_direct(system, w)[:, c])))
+        x, f = cell_maxima(fun, grid, mags[:, c], bounds)
         xs.append(x)
         fs.append(f)
     X = np.array(xs)
-    direct = _finite_or_inf(np.abs(system.frf_outputs(omega_rad_s=np.concatenate([X.ravel(), edges]))))
+    direct = _finite_or_inf(np.abs(_direct(system, np.concatenate([X.ravel(), edges]))))
     edge_vals, direct = direct[-len(edges):], direct[: -len(edges)]
     F = np.array([direct[i * X.shape[1]:(i + 1) * X.shape[1], c] for i, c in enumerate(cols)])
     if pr is not None:
@@ -292,6 +296,32 @@ def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
         if np.any(np.abs(sampled[ok] - F[ok]) > CONSISTENCY_RTOL * max(scale, 1e-300)):
             return None
     return F, X, bool(np.all(np.isfinite(mags[:, cols]))), edge_vals
+
+
+def _direct(system: LinearSystem, w: np.ndarray) -> np.ndarray:
+    """``system.frf_outputs(omega_rad_s=w)`` (the same batched solves ``Z(Ω)X = F``) with the polynomial forcing
+    evaluated for all Ω at once; anything unusual (a callable term, a non-finite F or Z, a singular Z) goes to
+    ``frf_outputs`` itself, which handles or names it."""
+    forcing = system.forcing
+    if not forcing.is_polynomial:
+        return system.frf_outputs(omega_rad_s=w)
+    w = np.asarray(w, dtype=float).ravel()
+    F = forcing.values(w)
+    with np.errstate(over="ignore", invalid="ignore"):
+        Z = (system.K[None] - w[:, None, None] ** 2 * system.M[None]) + 1j * w[:, None, None] * system.C[None]
+    if not (np.isfinite(F).all() and np.isfinite(Z).all()):
+        return system.frf_outputs(omega_rad_s=w)
+    try:
+        X = np.linalg.solve(Z, F[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return system.frf_outputs(omega_rad_s=w)
+    outputs = system.outputs.values()
+    rows = np.array([o.row for o in outputs])
+    orders = np.array([o.order for o in outputs])
+    with np.errstate(over="ignore", invalid="ignore"):
+        H = (X @ rows.T + system._feedthroughs(w)) * (1j * w[:, None]) ** orders[None, :]
+    H[~np.isfinite(H)] = np.inf
+    return H
 
 
 def _finite_or_inf(a: np.ndarray) -> np.ndarray:
@@ -340,14 +370,17 @@ def band_grid(poles: np.ndarray, band: tuple[float, float], max_delay: float = 0
     if max_delay > 0:
         uniform = min(uniform, 0.9 * GRID_FACTOR * 2 * np.pi / (4 * max_delay))
     parts = [np.linspace(lo, hi, int(np.ceil((hi - lo) / uniform)) + 1)]
-    upper = poles[poles.imag >= 0]
-    for s in upper:
-        sigma, omega = abs(s.real), s.imag
-        if sigma == 0:
-            continue
+    upper = poles[(poles.imag >= 0) & (poles.real != 0)]
+    if upper.size:  # every pole's points at once: u0 + i·δ exactly as np.arange(u0, u1 + POLE_STEP, POLE_STEP)
+        sigma, omega = np.abs(upper.real), upper.imag
         u0, u1 = np.arcsinh((lo - omega) / sigma), np.arcsinh((hi - omega) / sigma)
-        u = np.arange(u0, u1 + POLE_STEP, POLE_STEP)
-        parts.append(omega + sigma * np.sinh(u))
+        counts = np.maximum(np.ceil((u1 + POLE_STEP - u0) / POLE_STEP), 0).astype(np.intp)
+        delta = (u0 + POLE_STEP) - u0
+        first = np.zeros(len(counts), dtype=np.intp)
+        np.cumsum(counts[:-1], out=first[1:])
+        i = np.arange(int(counts.sum())) - np.repeat(first, counts)
+        u = np.repeat(u0, counts) + i * np.repeat(delta, counts)
+        parts.append(np.repeat(omega, counts) + np.repeat(sigma, counts) * np.sinh(u))
     if extra is not None:
         parts.append(np.asarray(extra, dtype=float))
     grid = np.unique(np.clip(np.concatenate(parts), lo, hi))

@@ -385,27 +385,39 @@ def plot_root_loci_before_after(loci: dict[str, pd.DataFrame], title: str, max_h
     return fig
 
 
-def plot_tradeoff(table: pd.DataFrame, quantity: str, title: str) -> Figure:
-    """U against a traded quantity: every design, the ε-sweep optima and the non-dominated front."""
-    fig = Figure(figsize=(6.4, 4.4))
+def plot_tradeoff(table: pd.DataFrame, quantity: str, title: str, required: float | None = None) -> Figure:
+    """U against a traded quantity: every design (campaign starts, sweep optima), the non-dominated front and,
+    with ``required``, the requirement as a vertical line."""
+    fig = Figure(figsize=(6.6, 4.4))
     ax = fig.subplots()
     starts = table[table["source"] == "start"]
     sweep = table[table["source"] == "sweep"]
     front = table[table["nondominated"]].sort_values(quantity)
-    ax.scatter(starts[quantity], starts["U"], s=10, color="0.6", label="campaign starts")
-    ax.scatter(sweep[quantity], sweep["U"], s=18, color="C0", label="ε-constraint optima")
-    ax.plot(front[quantity], front["U"], "C3.-", lw=1.2, label="non-dominated")
-    ax.set_xlabel(quantity)
-    ax.set_ylabel("U (objective)")
-    ax.set_title(title, fontsize=10)
+    ax.scatter(starts[quantity], starts["U"], s=10, color="0.6", marker="o", label="campaign starts")
+    ax.scatter(sweep[quantity], sweep["U"], s=22, color="C0", marker="s", label="constrained optima per target")
+    ax.plot(front[quantity], front["U"], color="C3", ls="-", marker=".", lw=1.2, label="non-dominated")
+    if required is not None:
+        ax.axvline(required, color="k", ls="--", lw=0.9, label=f"requirement {required:.4g}")
+    unit = " (m/s)" if quantity.endswith("_m_s") else " (m)" if "stroke" in quantity else ""
+    ax.set_xlabel(f"{quantity}{unit}")
+    ax.set_ylabel("U: certified peak of the objective output")
+    ax.set_title(title, fontsize=9, wrap=True)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
     fig.tight_layout()
     return fig
 
 
-def plot_surfaces(constrained, unconstrained, title: str) -> Figure:
-    """Fig 4.18: U over two variables as 3-D surfaces and contours, constrained and unconstrained."""
+BOUNDARY_STYLES = (("k", "--"), ("C1", ":"), ("C2", "-."), ("C4", "--"))
+MARK_STYLES = (("r", "*", 13), ("w", "X", 9), ("C1", "P", 9))
+
+
+def plot_surfaces(constrained, unconstrained, title: str, boundaries=(), marks=None) -> Figure:
+    """Fig 4.18: U over two variables as 3-D surfaces and contours, constrained and unconstrained.
+
+    ``boundaries`` (label, values on the constrained grid, limit, at_least) are drawn as contours ``values = limit``
+    on the constrained contour panel, the infeasible side hatched; ``marks`` (label -> design values) are marked on
+    both contour panels (e.g. the recommended design and the unconstrained optimum)."""
     fig = Figure(figsize=(12.0, 9.0))
     for row, (surf, label) in enumerate(((unconstrained, "unconstrained (bounds relaxed toward zero)"),
                                          (constrained, "constrained (inside the bounds)"))):
@@ -421,10 +433,25 @@ def plot_surfaces(constrained, unconstrained, title: str) -> Figure:
         cs = ax2.contourf(XI, XJ, Z, levels=20, cmap="viridis")
         fig.colorbar(cs, ax=ax2, label="log10 U")
         m = surf.minimum(inside_only=row == 1)
-        ax2.plot(np.log10(m[surf.names[0]]), np.log10(m[surf.names[1]]), "r*", ms=12, label="grid minimum")
+        ax2.plot(np.log10(m[surf.names[0]]), np.log10(m[surf.names[1]]), "c^", ms=8, label="grid minimum of U")
+        if row == 1:
+            for k, b in enumerate(boundaries):
+                color, ls = BOUNDARY_STYLES[k % len(BOUNDARY_STYLES)]
+                values = np.where(np.isfinite(b.values), b.values, np.nanmax(b.values[np.isfinite(b.values)])
+                                  if np.any(np.isfinite(b.values)) else 0.0)
+                if np.nanmin(values) < b.limit < np.nanmax(values):
+                    ax2.contour(XI, XJ, values, levels=[b.limit], colors=color, linestyles=ls, linewidths=1.8)
+                    bad = values < b.limit if b.at_least else values > b.limit
+                    ax2.contourf(XI, XJ, bad.astype(float), levels=[0.5, 1.5], colors="none", hatches=["//"])
+                ax2.plot([], [], color=color, ls=ls, label=f"{b.label} ({b.limit:.4g}); hatched: violated")
+        for k, (name, values) in enumerate((marks or {}).items()):
+            color, marker, ms = MARK_STYLES[k % len(MARK_STYLES)]
+            ax2.plot(np.log10(values[surf.names[0]]), np.log10(values[surf.names[1]]), marker=marker, color=color,
+                     ms=ms, ls="none", markeredgecolor="k", label=name)
         ax2.set_xlabel(f"log10 {surf.names[0]}")
         ax2.set_ylabel(f"log10 {surf.names[1]}")
-        ax2.legend(fontsize=8)
+        ax2.set_title(label, fontsize=9)
+        ax2.legend(fontsize=7, loc="lower right", framealpha=0.85)
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     return fig

@@ -78,8 +78,10 @@ def test_overdamped_mode_contributes_value_at_lower_edge():
 
 @pytest.mark.parametrize("band", [(2.0, 1.0), (1.0, 1.0), (-1.0, 2.0), (0.0, np.inf), (np.nan, 1.0)])
 def test_bad_band_is_rejected_naming_the_field(chain3, band):
-    with pytest.raises(ValueError, match="^band:"):
+    with pytest.raises(ValueError, match="^band_rad_s:"):
         chain3.response_maxima(band_rad_s=band)
+    with pytest.raises(ValueError, match="^band_hz:"):
+        chain3.response_maxima(band_hz=band)
 
 
 def test_exact_option_grid_is_logarithmic_in_damping():

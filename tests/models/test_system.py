@@ -116,7 +116,7 @@ def test_empty_system_complex_output_and_band_of_three_name_the_field():
     with pytest.raises(ValueError, match="^output: must be real"):
         LinearSystem(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], [1.0 + 1j, 0.0])
     sys = LinearSystem([[1.0]], [[0.1]], [[1.0]], [1.0], [1.0])
-    with pytest.raises(ValueError, match="^band: must be a pair"):
+    with pytest.raises(ValueError, match=r"^band_rad_s: must be a pair \(lower, upper\) in rad/s"):
         sys.response_maxima(band_rad_s=(0.0, 1.0, 2.0))
 
 

@@ -86,7 +86,7 @@ def test_run_publishes_results_and_refuses_to_overwrite_a_store(tmp_path, capsys
         assert (out / name).is_file(), name
     assert not list(results.glob(".staging-*"))
     comparison = pd.read_csv(out / "comparison.csv")
-    assert abs(comparison["rel_err_vs_nishihara_asami"].iloc[0]) < 1e-4
+    assert abs(comparison["change_vs_nishihara_asami"].iloc[0]) < 1e-4
     before = (out / "campaigns" / "mu0.05-exact-slsqp.sqlite").read_bytes()
     assert main(["run", str(study), "--results", str(results), "--workers", "0", "--no-progress"]) == 2
     assert "--resume" in capsys.readouterr().err

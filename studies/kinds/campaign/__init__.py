@@ -18,7 +18,7 @@ Modules: :mod:`.config` (the config), :mod:`.run` (compute), :mod:`.tradeoffs` (
 from railopt.studies.kind import StudyKind, register_kind
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
 from railopt.studies.kinds.campaign.report import report
-from railopt.studies.kinds.campaign.run import campaign_problem, compute, design_peak
+from railopt.studies.kinds.campaign.run import campaign_problem, compute, design_peak, warnings
 
 __all__ = ["KIND", "CampaignStudyConfig", "campaign_problem", "compute", "design_peak", "report"]
 
@@ -27,5 +27,6 @@ KIND = register_kind(StudyKind(
     config_model=CampaignStudyConfig,
     compute=compute,
     report=report,
-    summary="multi-start minimax campaign (methods × objectives) of a catalogued model",
+    summary="multi-start minimax campaign (problems × methods × objectives) of a catalogued model",
+    warnings=warnings,
 ))

@@ -97,14 +97,16 @@ class ConstraintSpec(OutputSpec):
 class StabilitySpec(FiniteModel):
     """``[stability]``: the stability constraints of the constrained problem (SPEC §2.5).
 
-    Every vehicle mode's root must satisfy Re s + σ_min ≤ 0 at ``speeds`` speeds evenly spaced up to the
-    required speed (``required_speed_m_s``, default the model's maximum operating speed), on each of ``tracks``
-    (default: every track of the model's stability families); track modes and the modes named in ``exclude``
-    are left out; with ``zeta_min`` every kept mode is also at least that damped.  Each optimum's critical
-    speeds are then confirmed by the hunting check.
+    Every vehicle mode's root must satisfy Re s + σ_min ≤ 0 at ``speeds`` speeds evenly spaced from
+    ``lowest_speed_m_s`` up to the required speed (``required_speed_m_s``, default the model's maximum operating
+    speed), on each of ``tracks`` (default: every track of the model's stability families); track modes and the
+    modes named in ``exclude`` are left out; with ``zeta_min`` every kept mode is also at least that damped.
+    Each optimum's critical speeds are then confirmed by the hunting check.
     """
 
     speeds: int = Field(4, ge=1, le=50, strict=True)
+    lowest_speed_m_s: float | None = Field(None, gt=0, lt=1000, description="first speed of the grid (default: "
+                                           "the required speed / speeds)")
     sigma_min: float = Field(0.0, ge=0, description="1/s")
     zeta_min: float | None = Field(None, ge=0, lt=1)
     required_speed_m_s: float | None = Field(None, gt=0, lt=1000)
@@ -117,7 +119,8 @@ class StabilitySpec(FiniteModel):
     def target(self, setup: ModelSetup, required: float | None = None) -> StabilityTarget:
         """The rows at ``speeds`` speeds up to ``required`` (m/s; default :meth:`required`)."""
         top = required or self.required(setup)
-        speeds = tuple(float(v) for v in np.linspace(top / self.speeds, top, self.speeds))
+        low = min(self.lowest_speed_m_s or top / self.speeds, top)
+        speeds = tuple(float(v) for v in np.linspace(low, top, self.speeds))
         return StabilityTarget(tuple(self.tracks or setup.stability), speeds, self.sigma_min, self.zeta_min,
                                tuple(self.exclude))
 
@@ -131,6 +134,17 @@ class CampaignDesign(CampaignSettings):
     problems: list[Literal["constrained", "unconstrained"]] = Field(
         default=["constrained"], min_length=1,
         description="constrained: subject to [[constraints]] and [stability]; unconstrained: the objective alone")
+    constrained_methods: list[MethodName] | None = Field(
+        None, description="methods of the constrained problem when both problems run (default: methods)")
+    constrained_objectives: list[Literal["thesis", "exact"]] | None = Field(
+        None, description="objectives of the constrained problem when both problems run (default: objectives)")
+
+    def plan(self, problem: str) -> list[tuple[str, str]]:
+        """(objective, method) pairs of one problem."""
+        constrained = problem == "constrained" and len(self.problems) > 1
+        objectives = (self.constrained_objectives if constrained else None) or self.objectives
+        methods = (self.constrained_methods if constrained else None) or self.methods
+        return [(o, m) for o in objectives for m in methods]
     start_from: list[str] = Field(default_factory=list, description="named designs of each model used as starts")
     points: list[dict[str, float]] = Field(default_factory=list, description="explicit starts {variable: value}")
     checks: list[str] = Field(default_factory=lambda: ["spectral_abscissa"], description="checks of each optimum")

@@ -7,6 +7,7 @@ campaign), then per model the before/after (Figs 4.13–4.17), the trade-offs an
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from railopt.studies.kinds.campaign.run import BeforeAfter, CampaignResult, ModelSections
@@ -25,8 +26,9 @@ __all__ = ["report"]
 
 
 def _main_columns(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
-    cols = ["model", "objective", "method", *names, "U_objective", "true_peak", "objective_underestimate",
-            "converged", "starts", "distinct_optima", "evaluations", "wall_time_s", "all_optima_pass_checks"]
+    cols = ["model", "problem", "objective", "method", *names, "U_objective", "true_peak", "objective_underestimate",
+            "active_bounds", "converged", "starts", "distinct_optima", "failing_optima", "best_failing_U",
+            "evaluations", "wall_time_s"]
     return comparison[[c for c in cols if c in comparison.columns]]
 
 
@@ -56,13 +58,16 @@ def comparison_section(result: CampaignResult, writer: Writer) -> list[str]:
         "`thesis` minimises the response maxima (4.71)–(4.73) (|H| at the damped natural frequencies and the",
         "band edges); `exact` minimises the certified band maximum. `true_peak` is the certified band maximum",
         "at the best design found; `objective_underestimate` is how far the minimised value lies below it.",
+        "A campaign's best design is its best distinct optimum that passes every check (`design.checks`); the",
+        "optima that fail them are counted in `failing_optima` and the best of them is `best_failing_U`",
+        "(never reported as an optimum: `optima.csv` has each with its checks).",
         "",
         markdown_table(_main_columns(comparison, names)),
         "",
     ]
     for ref in cfg.report.compare:
-        cols = ["model", "objective", "method", f"{ref}_peak", f"rel_err_vs_{ref}"]
-        cols += [f"{n}_err_vs_{ref}" for n in names]
+        cols = ["model", "problem", "objective", "method", f"{ref}_peak", f"change_vs_{ref}"]
+        cols += [f"{n}_change_vs_{ref}" for n in names]
         lines += [f"Against `{ref}` (its certified peak, and the best design's differences):", "",
                   markdown_table(comparison[[c for c in cols if c in comparison.columns]]), ""]
     lines += [
@@ -108,20 +113,22 @@ def _tradeoff(result: CampaignResult, s: ModelSections, t: Tradeoff, writer: Wri
     stem, q, spec = f"{t.spec.name}{s.tag}", t.quantity, t.spec
     writer.table(t.table, f"tradeoff_{stem}")
     writer.table(t.front, f"pareto_{stem}")
-    writer.figure(plot_tradeoff(t.table, q, f"{s.model}: U against {q} ({spec.name})"), f"pareto_{stem}",
-                  dpi=result.config.report.dpi)
-    md = [f"Trade-off `{spec.name}`: {len(t.front)} non-dominated designs among {len(t.table)} distinct designs "
-          f"(ε-sweep optima and every start); `pareto_{stem}.csv`:", "",
-          markdown_table(t.front[["source", "U", q, *names]].head(12), digits=5), ""]
-    if t.flagged:
-        need = t.after_check.get("required_speed_m_s", float("nan"))
-        md += [f"**The best optimum is flagged**: its `{spec.check}` value is {t.after_check['value']:.4g} "
-               f"against the required {need:.4g}, so it is not a recommendable design."]
+    writer.figure(plot_tradeoff(t.table, q, f"{s.model}: U against {q} ({spec.name})", required=t.required),
+                  f"pareto_{stem}", dpi=result.config.report.dpi)
+    how = ("the constrained problem solved with the stability rows required up to each speed"
+           if spec.check == "hunting" else f"the constrained problem solved at each limit of {spec.output}"
+           if spec.output else f"the {spec.check} check held above each value")
+    md = [f"Trade-off `{spec.name}` ({how}; targets {', '.join(f'{e:g}' for e in spec.epsilons)}): "
+          f"{len(t.front)} non-dominated designs among {len(t.table)} distinct designs (sweep optima and every "
+          f"start; `count` = how many identical designs each row stands for); `pareto_{stem}.csv`:", "",
+          markdown_table(t.front[["source", "count", "U", q, *names]].head(12), digits=5), ""]
+    if t.required is not None:
+        sense = "≥" if spec.check is not None else "≤"
         if t.pick is not None:
-            pick = t.pick
-            md += [f"The best design of this trade-off that meets it: U = {pick['U']:.5g} "
-                   f"({100 * (pick['U'] / s.best['true_peak'] - 1):+.1f} % against the unconstrained optimum), "
-                   f"{spec.check} = {pick[q]:.4g}; " + ", ".join(f"{n} = {pick[n]:.4g}" for n in names) + ".", ""]
+            md += [f"Best design of the front with {q} {sense} {t.required:.4g}: U = {t.pick['U']:.5g}, "
+                   f"{q} = {t.pick[q]:.4g}.", ""]
+        else:
+            md += [f"No design of the front has {q} {sense} {t.required:.4g}.", ""]
     return md
 
 
@@ -135,12 +142,22 @@ def _surface(result: CampaignResult, s: ModelSections, g: TradeoffSurfaces, writ
     stem = f"surface_{a}_{b}{s.tag}"
     writer.table(g.constrained.to_pandas(), f"{stem}_constrained")
     writer.table(g.unconstrained.to_pandas(), f"{stem}_unconstrained")
-    writer.figure(plot_surfaces(g.constrained, g.unconstrained, f"{s.model}: U over {a} × {b}"), stem,
-                  dpi=result.config.report.dpi)
+    for bd in g.boundaries:
+        writer.table(g.constrained.to_pandas().assign(**{bd.label.split(" ")[0]: bd.values.ravel()}),
+                     f"{stem}_{bd.label.split(' ')[0].replace(' ', '_')}")
+    writer.figure(plot_surfaces(g.constrained, g.unconstrained, f"{s.model}: U over {a} × {b}",
+                                boundaries=g.boundaries, marks=g.marks), stem, dpi=result.config.report.dpi)
     cmin, umin = g.constrained.minimum(), g.unconstrained.minimum(inside_only=False)
-    return [f"Objective surface over {g.spec.variables} (others at the optimum): least U on the constrained "
-            f"grid {cmin['U']:.4g} at {cmin[a]:.4g}, {cmin[b]:.4g}; on the grid relaxed toward zero "
-            f"{umin['U']:.4g} at {umin[a]:.4g}, {umin[b]:.4g}.", "", f"![surfaces]({stem}.png)", ""]
+    md = [f"Objective surface over {g.spec.variables} (others at the {next(iter(g.marks), 'optimum')} design): "
+          f"least U on the constrained grid {cmin['U']:.4g} at {cmin[a]:.4g}, {cmin[b]:.4g}; on the grid relaxed "
+          f"toward zero {umin['U']:.4g} at {umin[a]:.4g}, {umin[b]:.4g}."]
+    for bd in g.boundaries:
+        feasible = bd.values >= bd.limit if bd.at_least else bd.values <= bd.limit
+        inside = np.where(feasible & g.constrained.inside, g.constrained.values, np.inf)
+        best = float(np.min(inside)) if np.isfinite(np.min(inside)) else float("nan")
+        md[-1] += (f" {bd.label} ({bd.limit:.4g}) is drawn on the constrained panel; {int(feasible.sum())} of "
+                   f"{feasible.size} grid points meet it (least U among them {best:.4g}).")
+    return md + ["", f"![surfaces]({stem}.png)", ""]
 
 
 def surfaces_section(result: CampaignResult, s: ModelSections, writer: Writer) -> list[str]:
@@ -148,13 +165,73 @@ def surfaces_section(result: CampaignResult, s: ModelSections, writer: Writer) -
     return [line for g in s.surfaces for line in _surface(result, s, g, writer)]
 
 
+def _value(x: object, digits: int = 5) -> str:
+    return "" if x is None or (isinstance(x, float) and not np.isfinite(x)) else f"{x:.{digits}g}"
+
+
+def recommended_section(result: CampaignResult, writer: Writer) -> list[str]:
+    """recommended.csv (one row per model: variables, element values, U, critical speeds, constraint peaks) and
+    the summary's first section: the recommended design beside the existing one and the unconstrained optimum."""
+    rows = [s.recommended.row() for s in result.sections if s.recommended is not None]
+    if rows:
+        writer.table(pd.DataFrame(rows), "recommended")
+    cfg = result.config
+    names = [v.name for v in cfg.design.variables]
+    md: list[str] = []
+    for s in result.sections:
+        rec, ref = s.recommended, s.unconstrained
+        md += [f"## Recommended design: {s.model}", ""]
+        if rec is None:
+            md += ["**No recommended design**: no optimum of the constrained problem passes every check and "
+                   "constraint (see `optima.csv`).", ""]
+            continue
+        table: list[tuple[str, str, str, str]] = []
+
+        def add(label, ex, r, u, table=table):
+            table.append((label, *(v if isinstance(v, str) else _value(v) for v in (ex, r, u))))
+
+        ex_values = result.named.get(s.model, {})
+        for n in names:
+            add(n, ex_values.get(n), rec.values[n], None if ref is None else ref["values"][n])
+        add(f"U: peak {cfg.objective.output} (certified)", rec.existing_U, rec.U, None if ref is None else ref["U"])
+        add("reduction factor against existing", 1.0 if rec.existing_U else None,
+            rec.existing_U / rec.U if rec.existing_U else None,
+            rec.existing_U / ref["U"] if rec.existing_U and ref is not None else None)
+        for name, payload in rec.checks.items():
+            for key, value in payload.items():
+                if isinstance(value, bool) or key.startswith("least_damping"):
+                    continue
+                ex_check = result.existing_checks.get(s.model, {}).get(name, {})
+                ref_value = None if ref is None else ref["checks"][name].payload().get(key)
+                add(key, ex_check.get(key), value, ref_value)
+        for c in rec.constraints:
+            ref_peak = None if ref is None else next(
+                r["peak"] for r in ref["constraints"] if r["output"] == c["output"])
+            add(f"{c['output']} peak (limit {c['limit']:.4g})", None, c["peak"], ref_peak)
+        columns = pd.DataFrame(table, columns=["quantity", "existing", "recommended", "unconstrained optimum"])
+        verdict = ", ".join(f"{k} {'yes' if v else 'NO'}" for n, p in rec.checks.items()
+                            for k, v in p.items() if isinstance(v, bool))
+        md += [f"The best distinct optimum of the {rec.source['problem']} problem ({rec.source['objective']} "
+               f"objective, {rec.source['method']}, start {rec.source['start_id']}) that passes every check "
+               f"({verdict}) and meets every constraint; written to `recommended.csv` (element values in SI):", "",
+               markdown_table(columns), ""]
+        if ref is not None:
+            failing = [f"{n}: {k}" for n, r in ref["checks"].items() for k, v in r.flags.items() if not v]
+            note = ("it fails the check(s) " + ", ".join(f"{f} (is false)" for f in failing)
+                    + " — shown for comparison only, not recommendable"
+                    if failing else "it passes every check")
+            md += [f"The unconstrained optimum (the objective alone): U = {_value(ref['U'])}; {note}.", ""]
+    return md
+
+
 MODEL_SECTIONS = [before_after_section, tradeoffs_section, surfaces_section]
 """The sections of each model, in order (after the comparison)."""
 
 
 def report(result: CampaignResult, writer: Writer) -> str:
-    """Write every table and figure; the summary markdown."""
+    """Write every table and figure; the summary markdown (the recommended design first)."""
     head = comparison_section(result, writer)
+    recommended = recommended_section(result, writer)
     extra: list[str] = []
     for s in result.sections:
         if s.best is None:
@@ -162,4 +239,4 @@ def report(result: CampaignResult, writer: Writer) -> str:
             continue
         for section in MODEL_SECTIONS:
             extra += section(result, s, writer)
-    return "\n".join(head) + "\n".join(extra)
+    return "\n".join(head[:4] + recommended + head[4:]) + "\n".join(extra)

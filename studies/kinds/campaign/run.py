@@ -19,7 +19,13 @@ from railopt.models.units import m_to_in
 from railopt.studies.adapter import minimax_problem
 from railopt.studies.catalog import Check, ModelSetup
 from railopt.studies.kind import StudyContext, dask_context
-from railopt.studies.kinds.campaign.config import CampaignSettings, CampaignStudyConfig
+from railopt.studies.kinds.campaign.config import (
+    CampaignSettings,
+    CampaignStudyConfig,
+    ConstraintSpec,
+    StabilitySpec,
+    TradeoffSpec,
+)
 from railopt.studies.kinds.campaign.tradeoffs import Tradeoff, TradeoffSurfaces, surfaces, tradeoff_table
 
 __all__ = [
@@ -27,6 +33,7 @@ __all__ = [
     "CampaignResult",
     "ModelSections",
     "campaign_label",
+    "Recommended",
     "campaign_problem",
     "check_optima",
     "check_stores",
@@ -34,6 +41,7 @@ __all__ = [
     "design_peak",
     "run_campaign",
     "store_path",
+    "warnings",
 ]
 
 
@@ -163,6 +171,13 @@ def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str,
                  "wall_time_s": float(table["wall_time"].sum())}
     flags = [f for f in flags if f in optima.columns]  # no optima: no check columns
     row["all_optima_pass_checks"] = bool(optima[flags].all().all()) if flags and len(optima) else None
+    # never an unstable design as the best: the best optimum is the best that passes every check
+    passing = optima[optima[flags].all(axis=1)] if flags and len(optima) else optima
+    row["failing_optima"] = len(optima) - len(passing)
+    if flags and len(optima) and len(passing) < len(optima):
+        failing = optima.drop(passing.index).sort_values("value").iloc[0]
+        row["best_failing_U"] = float(failing["value"])
+    ok = ok[ok["start_id"].isin(passing["start_id"])] if flags and len(optima) else ok
     if len(ok):
         best = ok.sort_values(["value", "start_id"]).iloc[0]
         values = {n: float(best[n]) for n in names}
@@ -213,6 +228,98 @@ def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], compari
     return panels
 
 
+# ---------------------------------------------------------------------------------------------- recommended design
+@dataclass(frozen=True)
+class Recommended:
+    """The recommended design of one model: the best (certified U) distinct optimum of the constrained problem
+    that passes every check (stable to the required speed) and meets every constraint.
+
+    ``values`` are the design variables; ``parameters`` the family's parameters they set (element ids, SI);
+    ``checks`` the payload of each check (critical speeds on each track, least damping, ...);
+    ``constraints`` per constraint: output, certified peak, limit."""
+
+    model: str
+    source: dict[str, object]
+    values: dict[str, float]
+    parameters: dict[str, float]
+    U: float
+    existing_U: float | None
+    checks: dict[str, dict]
+    constraints: list[dict]
+
+    def row(self) -> dict:
+        """One row of ``recommended.csv``: the source, the variables, the element values (SI), U, the reduction
+        against the existing design, every check's numbers and every constraint's peak and limit."""
+        out: dict = {"model": self.model, **self.source, **self.values}
+        out |= {k: v for k, v in self.parameters.items() if k not in self.values}
+        out |= {"U": self.U, "existing_U": self.existing_U,
+                "reduction_factor": self.existing_U / self.U if self.existing_U else None}
+        for payload in self.checks.values():
+            out |= payload
+        for c in self.constraints:
+            out |= {f"{c['output']}_peak": c["peak"], f"{c['output']}_limit": c["limit"]}
+        return out
+
+
+def _constraint_peaks(cfg: CampaignStudyConfig, setup: ModelSetup, p: np.ndarray) -> list[dict]:
+    system = setup.family.at(p)
+    return [{"output": c.output, "limit": c.limit_value(setup),
+             "peak": system.peak(band_hz=c.band_hz, exact=True, output=c.output)} for c in cfg.constraints]
+
+
+def _recommend(cfg: CampaignStudyConfig, setup: ModelSetup, model: str, optima: dict, flags: dict,
+               problem: str = "constrained") -> Recommended | None:
+    """The best distinct optimum of ``problem`` over every objective and method that passes all its checks and
+    meets every constraint (certified), or None."""
+    names = [v.name for v in cfg.design.variables]
+    best: tuple[float, dict, tuple] | None = None
+    for key, found in optima.items():
+        if key[0] != model or key[1] != problem or found.empty:
+            continue
+        keep = [f for f in flags[key] if f in found.columns]
+        passing = found[found[keep].all(axis=1)] if keep else found
+        for _, r in passing.iterrows():
+            values = {n: float(r[n]) for n in names}
+            U = design_peak(cfg, setup, values)
+            if best is None or U < best[0]:
+                best = (U, values, (key, int(r["start_id"])))
+    if best is None:
+        return None
+    U, values, ((_, prob, objective, method), start) = best
+    p = _p(cfg, setup, values)
+    peaks = _constraint_peaks(cfg, setup, p) if problem == "constrained" else []
+    if any(c["peak"] > c["limit"] * (1 + 1e-6) for c in peaks):
+        return None
+    existing = setup.named_designs.get("existing")
+    existing_U = design_peak(cfg, setup, existing) if existing is not None else None
+    designed = {n: setup.parameter_map.aliases.get(n, n) for n in names}
+    parameters = {pid: float(p[list(setup.family.parameters).index(pid)]) for pid in designed.values()
+                  if pid in setup.family.parameters}
+    checks = {name: setup.checks[name](p).payload() for name in cfg.design.checks}
+    return Recommended(model, {"problem": prob, "objective": objective, "method": method, "start_id": start},
+                       values, parameters, U, existing_U, checks, peaks)
+
+
+def warnings(cfg: CampaignStudyConfig) -> list[str]:
+    """An existing design that fails a check (e.g. hunts below the required speed): the study still runs."""
+    out = []
+    for i, ref in enumerate(cfg.models):
+        setup = ref.setup(f"models[{i}]")
+        existing = setup.named_designs.get("existing")
+        if existing is None:
+            continue
+        names = [n for n in existing if n in setup.family.parameters]
+        p, _ = setup.parameters(names, np.array([existing[n] for n in names]))
+        for name in cfg.design.checks:
+            result = setup.checks[name](p)
+            failed = [f for f, ok in result.flags.items() if not ok]
+            if failed:
+                numbers = ", ".join(f"{k} = {v:.4g}" for k, v in result.data.items())
+                out.append(f"models[{i}] ({ref.label}): the existing design fails the {name!r} check "
+                           f"({', '.join(failed)} is false: value {result.value:.4g}; {numbers})")
+    return out
+
+
 # ---------------------------------------------------------------------------------------------- report sections
 @dataclass(frozen=True)
 class BeforeAfter:
@@ -238,12 +345,20 @@ class ModelSections:
     before_after: BeforeAfter | None = None
     tradeoffs: list[Tradeoff] = field(default_factory=list)
     surfaces: list[TradeoffSurfaces] = field(default_factory=list)
+    recommended: Recommended | None = None
+    unconstrained: dict | None = None
 
 
 def _check_rows(cfg: CampaignStudyConfig, setup: ModelSetup, designs: dict[str, np.ndarray]) -> pd.DataFrame | None:
     rows = [{"design": label, "check": name, "value": (r := setup.checks[name](p)).value, **r.payload()}
             for label, p in designs.items() for name in cfg.design.checks]
     return pd.DataFrame(rows) if rows else None
+
+
+def _where(rm) -> str:
+    """Where a band maximum lies: "band edge" (the response still rising there) or "resonance"."""
+    k = int(np.argmax(rm.values))
+    return "band edge" if k >= len(rm.values) - 2 or rm.frequencies[k] in rm.band else "resonance"
 
 
 def _active_bounds(cfg: CampaignStudyConfig, after: dict[str, float]) -> list[str]:
@@ -269,7 +384,8 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
         rb = sys_b.response_maxima(band_rad_s=band, exact=True, output=o)
         ra = sys_a.response_maxima(band_rad_s=band, exact=True, output=o)
         row = {"output": o, "before": rb.value, "after": ra.value, "reduction_factor": rb.value / ra.value,
-               "before_at_hz": rb.argmax_frequency / HZ, "after_at_hz": ra.argmax_frequency / HZ,
+               "before_at_hz": rb.argmax_frequency / HZ, "before_peak_is": _where(rb),
+               "after_at_hz": ra.argmax_frequency / HZ, "after_peak_is": _where(ra),
                "certified": rb.certified and ra.certified}
         if o in cfg.report.inch_outputs:
             row |= {"before_in": m_to_in(rb.value), "after_in": m_to_in(ra.value)}  # in, in/s or in/s² by quantity
@@ -300,38 +416,129 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
                        _check_rows(cfg, setup, {"before": p_before, "after": p_after}), loci)
 
 
-def _after_check(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, float]) -> dict | None:
-    """The first design check at the best optimum (value and payload), or None without checks."""
-    if not cfg.design.checks:
+def _sweep_problems(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str, spec: TradeoffSpec
+                    ) -> list[tuple[float, MinimaxProblem]]:
+    """The constrained problem at each target of ``spec``: the output held below ε (replacing its constraint's
+    limit, or added), the stability rows required up to the speed ε (``hunting``), or another check ≥ ε."""
+    out = []
+    for e in spec.epsilons:
+        if spec.output is not None:
+            index = next((i for i, c in enumerate(cfg.constraints) if c.output == spec.output), None)
+            if index is not None:
+                problem = campaign_problem(cfg, setup, objective, "constrained", limits={index: e})
+            else:
+                extra = ConstraintSpec(output=spec.output, band_hz=cfg.objective.band_hz, limit=e, exact=spec.exact)
+                problem = campaign_problem(cfg.model_copy(update={"constraints": [*cfg.constraints, extra]}),
+                                           setup, objective, "constrained")
+        elif spec.check == "hunting":
+            stable = cfg if cfg.stability is not None else cfg.model_copy(update={"stability": StabilitySpec()})
+            problem = campaign_problem(stable, setup, objective, "constrained", required_speed=e)
+        else:
+            check, names = setup.checks[spec.check], [v.name for v in cfg.design.variables]
+            problem = campaign_problem(cfg, setup, objective, "unconstrained").with_constraints(
+                _CheckConstraint(setup, names, check), epsilon=-e)
+        out.append((e, problem))
+    return out
+
+
+@dataclass(frozen=True)
+class _CheckConstraint:
+    """g(x) = −check value (≥ ε as −value ≤ −ε); a check stable over its whole range puts no constraint."""
+
+    setup: ModelSetup
+    names: list[str]
+    check: Check
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        value = self.check(self.setup.parameters(self.names, x)[0]).value
+        return np.array([-value if np.isfinite(value) else -1e12])
+
+
+@dataclass(frozen=True)
+class _DesignValues:
+    """Values at a design x (a task on dask): the hunting check's critical speed and the constraints' peaks."""
+
+    cfg: CampaignStudyConfig
+    setup: ModelSetup
+    hunting: bool
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        names = [v.name for v in self.cfg.design.variables]
+        p, _ = self.setup.parameters(names, np.asarray(x, dtype=float))
+        out = [self.setup.checks["hunting"](p).value] if self.hunting else []
+        return np.array(out + [c["peak"] for c in _constraint_peaks(self.cfg, self.setup, p)])
+
+
+def _quantity(cfg: CampaignStudyConfig, setup: ModelSetup, spec: TradeoffSpec):
+    names = [v.name for v in cfg.design.variables]
+
+    def value(x: np.ndarray) -> float:
+        p, _ = setup.parameters(names, x)
+        if spec.output is not None:
+            return setup.family.at(p).peak(band_hz=cfg.objective.band_hz, exact=spec.exact, output=spec.output)
+        return setup.checks[spec.check](p).value
+
+    return value
+
+
+def _unconstrained_best(cfg: CampaignStudyConfig, setup: ModelSetup, model: str, tables: dict) -> dict | None:
+    """The best unconstrained optimum whatever its checks say (for comparison beside the recommended design)."""
+    names = [v.name for v in cfg.design.variables]
+    rows = [t[t["success"]] for (m, prob, _, _), t in tables.items() if m == model and prob == "unconstrained"]
+    rows = [r for r in rows if len(r)]
+    if not rows:
         return None
-    r = setup.checks[cfg.design.checks[0]](_p(cfg, setup, after))
-    return {"value": r.value, **r.payload()}
+    best = pd.concat(rows).sort_values(["value", "start_id"]).iloc[0]
+    values = {n: float(best[n]) for n in names}
+    p = _p(cfg, setup, values)
+    return {"values": values, "U": design_peak(cfg, setup, values),
+            "checks": {name: setup.checks[name](p) for name in cfg.design.checks},
+            "constraints": _constraint_peaks(cfg, setup, p)}
 
 
 def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, comparison: pd.DataFrame,
-                    tables: dict, tag: str, client) -> ModelSections:
-    """The before/after, trade-off and surface sections of one model, at its best optimum of the exact
-    objective (or of the first objective when exact is not run)."""
+                    tables: dict, tag: str, client, recommended: Recommended | None) -> ModelSections:
+    """The before/after, trade-off and surface sections of one model, at its recommended design (or, without
+    one, its best optimum passing the checks of the exact objective, or of the first objective)."""
     names = [v.name for v in cfg.design.variables]
     objective = "exact" if "exact" in cfg.design.objectives else cfg.design.objectives[0]
     rows = comparison[(comparison["model"] == model) & (comparison["objective"] == objective)
                       & (comparison["problem"] == cfg.design.problems[0])]
     rows = rows[np.isfinite(rows.get("true_peak", pd.Series(dtype=float)))]
-    if rows.empty:
+    if rows.empty and recommended is None:
         return ModelSections(model, tag, None, objective)
-    best = rows.sort_values("true_peak").iloc[0]
-    after = {n: float(best[n]) for n in names}
-    problem = campaign_problem(cfg, setup, objective)
+    best = rows.sort_values("true_peak").iloc[0] if len(rows) else None
+    after = dict(recommended.values) if recommended is not None else {n: float(best[n]) for n in names}
+    if best is None or recommended is not None:
+        best = pd.Series({**after, "true_peak": recommended.U, **recommended.source})
     band = cfg.objective.target(setup, exact=True).band
     before_after = _before_after(cfg, setup, after, band) if cfg.report.before else None
-    starts = pd.concat([t for (m, prob, o, _), t in tables.items() if m == model and o == objective])
-    target = cfg.objective.target(setup, exact=objective == "exact")
-    hunting_after = _after_check(cfg, setup, after)
-    tradeoffs = [tradeoff_table(problem, setup, target, spec, band, starts, cfg.design.seed, client, hunting_after)
-                 for spec in cfg.tradeoffs]
+    starts = pd.concat([t for (m, _, o, _), t in tables.items() if m == model])
     x_after = np.array([after[n] for n in names])
-    grids = [surfaces(problem, spec, x_after, client) for spec in cfg.surfaces]
-    return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids)
+    tradeoffs = []
+    for spec in cfg.tradeoffs:
+        required = None
+        if spec.check == "hunting":
+            required = (cfg.stability.required(setup) if cfg.stability is not None else setup.required_speed)
+        elif spec.output is not None:
+            limits = [c.limit_value(setup) for c in cfg.constraints if c.output == spec.output]
+            required = limits[0] if limits else None
+        tradeoffs.append(tradeoff_table(
+            spec, _sweep_problems(cfg, setup, objective, spec), starts, _quantity(cfg, setup, spec),
+            lambda x: design_peak(cfg, setup, dict(zip(names, x, strict=True))), cfg.design.seed,
+            points=[list(x_after)], client=client, required=required))
+    reference = _unconstrained_best(cfg, setup, model, tables)
+    marks = {"recommended" if recommended is not None else "optimum": after}
+    if reference is not None:
+        marks["unconstrained optimum"] = reference["values"]
+    hunting = "hunting" in setup.checks and bool(setup.stability)
+    limits = ([("critical speed = required", (cfg.stability.required(setup) if cfg.stability is not None
+                                              else setup.required_speed), True)] if hunting else [])
+    limits += [(f"{c.output} = limit", c.limit_value(setup), False) for c in cfg.constraints]
+    problem = campaign_problem(cfg, setup, objective, "unconstrained")
+    grids = [surfaces(problem, spec, x_after, client, _DesignValues(cfg, setup, hunting), limits, marks)
+             for spec in cfg.surfaces]
+    return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids, recommended, reference)
 
 
 # ---------------------------------------------------------------------------------------------- compute
@@ -346,6 +553,8 @@ class CampaignResult:
     table: pd.DataFrame  # the CLI's short comparison
     frf_panels: list
     sections: list[ModelSections]
+    named: dict[str, dict[str, float]] = field(default_factory=dict)  # model -> its existing design
+    existing_checks: dict[str, dict[str, dict]] = field(default_factory=dict)  # model -> check -> payload
 
 
 def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str, str], context: StudyContext,
@@ -371,25 +580,31 @@ def compute(config: CampaignStudyConfig, context: StudyContext) -> CampaignResul
     cfg = config
     setups = cfg.setups()
     names = [v.name for v in cfg.design.variables]
-    keys = [(m, prob, o, meth) for m in setups for prob in cfg.design.problems for o in cfg.design.objectives
-            for meth in cfg.design.methods]
+    keys = [(m, prob, o, meth) for m in setups for prob in cfg.design.problems for o, meth in cfg.design.plan(prob)]
     check_stores(context, [campaign_label(m, o, meth, prob) for m, prob, o, meth in keys])
     tables: dict[tuple[str, str, str, str], pd.DataFrame] = {}
     optima: dict[tuple[str, str, str, str], pd.DataFrame] = {}
     rows = []
+    flags: dict[tuple[str, str, str, str], list[str]] = {}
     with dask_context(context) as client:
         for key in keys:
-            tables[key], optima[key], flags = _campaign(cfg, setups[key[0]], key, context, client)
-            rows.append(_comparison_row(cfg, setups[key[0]], key, tables[key], optima[key], flags))
+            tables[key], optima[key], flags[key] = _campaign(cfg, setups[key[0]], key, context, client)
+            rows.append(_comparison_row(cfg, setups[key[0]], key, tables[key], optima[key], flags[key]))
         comparison = pd.DataFrame(rows)
+        recommended = {m: _recommend(cfg, s, m, optima, flags, cfg.design.problems[0]) for m, s in setups.items()}
         sections = []
-        if cfg.report.before or cfg.tradeoffs or cfg.surfaces:
-            sections = [_model_sections(cfg, m, s, comparison, tables, "" if len(setups) == 1 else f"_{m}", client)
+        if cfg.report.before or cfg.tradeoffs or cfg.surfaces or any(recommended.values()):
+            sections = [_model_sections(cfg, m, s, comparison, tables, "" if len(setups) == 1 else f"_{m}", client,
+                                        recommended[m])
                         for m, s in setups.items()]
     starts = pd.concat([t.drop(columns=["functions"], errors="ignore").assign(model=m, problem=prob, objective=o,
                                                                              method=meth)
                         for (m, prob, o, meth), t in tables.items()], ignore_index=True)
     optima_table = pd.concat([t.assign(model=m, problem=prob, objective=o, method=meth)
                               for (m, prob, o, meth), t in optima.items()], ignore_index=True)
+    named = {m: {n: float(s.named_designs["existing"][n]) for n in names} for m, s in setups.items()
+             if "existing" in s.named_designs}
+    existing_checks = {m: {c: s.checks[c](_p(cfg, s, named[m])).payload() for c in cfg.design.checks}
+                       for m, s in setups.items() if m in named}
     return CampaignResult(cfg, comparison, starts, optima_table, _short(comparison, names),
-                          _frf_panels(cfg, setups, comparison), sections)
+                          _frf_panels(cfg, setups, comparison), sections, named, existing_checks)

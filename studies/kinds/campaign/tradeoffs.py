@@ -1,119 +1,153 @@
-"""Trade-offs and objective surfaces of a campaign study (thesis §4.3.3, Fig 4.18; SPEC §3).
+"""Trade-offs and objective surfaces of a campaign study (thesis §4.3.3, Fig 4.18; SPEC §3, §2.5).
 
-``[[tradeoffs]]``: ε-constraint sweeps of the campaign's problem — minimise U subject to the response
-maxima of another output below ε (e.g. the secondary lateral stroke), or subject to a check's value above ε
-(e.g. the critical speed from the ``hunting`` check) — and the non-dominated designs among the sweep
-optima *and every start of the campaign*, so no row of a Pareto table is dominated by anything computed.
+``[[tradeoffs]]``: constraint sweeps that solve the *constrained* problem at each target — the secondary
+stroke held below ε (an output constraint), or the stability rows of SPEC §2.5 required up to a speed ε
+(``check = "hunting"``, the critical speed confirmed afterwards by the hunting check) — so the front has no
+gap where feasible designs exist.  The sweep optima and every start of the campaign are merged into one
+table of distinct designs (identical designs counted once, with ``count``), and ``nondominated`` marks the
+front of (U, traded quantity).
 
-``[[surfaces]]``: U over a grid of two design variables with the others at the optimum, inside the bounds
-(constrained) and on a grid relaxed toward zero (unconstrained), where the thesis notes the trivial
-optimum of zero stiffness.
+``[[surfaces]]``: U over a grid of two design variables with the others at the recommended design, inside the
+bounds (constrained) and on a grid relaxed toward zero (unconstrained), where the thesis notes the trivial
+optimum of zero stiffness; with the values of the constraints on the constrained grid (critical speed, strokes)
+so the figure draws the constraint boundaries.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
-from railopt.design import MinimaxProblem, Surface, epsilon_sweep, nondominated, objective_surface
-from railopt.studies.adapter import ResponseTarget, minimax_problem
-from railopt.studies.catalog import ModelSetup
+from railopt.design import MinimaxProblem, Surface, map_unordered, multistart, nondominated, objective_surface
+from railopt.design.parallel import call
 from railopt.studies.kinds.campaign.config import SurfaceSpec, TradeoffSpec
 
-__all__ = ["Tradeoff", "TradeoffSurfaces", "constrained_problem", "surfaces", "sweep_designs", "tradeoff_table"]
+__all__ = ["Boundary", "Tradeoff", "TradeoffSurfaces", "distinct_designs", "surfaces", "sweep", "tradeoff_table"]
+
+DISTINCT_DIGITS = 6  # designs equal to 1e-6 of their unit-cube coordinates are one design
 
 
 @dataclass(frozen=True)
 class Tradeoff:
-    """One ε-constraint sweep: every distinct design with U and the traded quantity, the non-dominated front,
-    and — when the best optimum fails its first check — that check's result and the best design meeting it."""
+    """One constraint sweep: every distinct design with U and the traded quantity, the non-dominated front,
+    and — when the recommended design is judged against it — the best front design meeting the requirement."""
 
     spec: TradeoffSpec
     table: pd.DataFrame
     front: pd.DataFrame
     quantity: str
-    after_check: dict | None = None
+    required: float | None = None
     pick: pd.Series | None = None
 
-    @property
-    def flagged(self) -> bool:
-        """The best optimum fails the check this sweep trades against."""
-        return (self.spec.check is not None and self.after_check is not None
-                and not self.after_check.get("stable", True))
+
+@dataclass(frozen=True)
+class Boundary:
+    """A constraint's value on the constrained surface grid (``values[j, i]``) and its limit: the boundary is the
+    contour ``values = limit``; feasible is ``values ≥ limit`` when ``at_least`` else ``values ≤ limit``."""
+
+    label: str
+    values: np.ndarray
+    limit: float
+    at_least: bool
 
 
 @dataclass(frozen=True)
 class TradeoffSurfaces:
-    """U over two design variables: constrained (inside the bounds) and relaxed toward zero."""
+    """U over two design variables: constrained (inside the bounds) and relaxed toward zero; the constraint
+    boundaries on the constrained grid and the marked designs (label -> design values)."""
 
     spec: SurfaceSpec
     constrained: Surface
     unconstrained: Surface
+    boundaries: list[Boundary] = field(default_factory=list)
+    marks: dict[str, dict[str, float]] = field(default_factory=dict)
 
 
-def constrained_problem(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget,
-                        spec: TradeoffSpec, band: tuple[float, float]) -> MinimaxProblem:
-    """``problem`` with the constraint of ``spec`` (ε set later by the sweep).  An output constraint goes
-    through the one adapter, so objective and constraint share each x's system and eigen-decomposition."""
-    names = list(problem.space.names)
-    if spec.output is not None:
-        target = ResponseTarget(spec.output, band, spec.exact)
-        return minimax_problem(setup, problem.variables, objective, [target], [0.0])
-    check = setup.checks[spec.check]
-
-    def negative_check(x: np.ndarray) -> np.ndarray:
-        p, _ = setup.parameters(names, x)
-        value = check(p).value
-        return np.array([-value if np.isfinite(value) else -1e12])  # stable over the range: no constraint
-
-    return problem.with_constraints(negative_check)
-
-
-def sweep_designs(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget, spec: TradeoffSpec,
-                  band: tuple[float, float], starts: pd.DataFrame, seed: int, client=None) -> pd.DataFrame:
-    """Sweep optima and campaign starts with U and the traded quantity; ``nondominated`` marks the front."""
-    names = list(problem.space.names)
-    cp = constrained_problem(problem, setup, objective, spec, band)
-    eps = [-e for e in spec.epsilons] if spec.check is not None else list(spec.epsilons)
-    sweep = epsilon_sweep(cp, eps, n_starts=spec.n_starts, method=spec.method, seed=seed, client=client)
-    sweep = sweep[sweep["success"]].assign(source="sweep")
-    designs = pd.concat([sweep[[*names, "source"]],
-                         starts[np.isfinite(starts["value"])][names].assign(source="start")], ignore_index=True)
-    # one row per distinct design (many starts find the same optimum)
-    designs = designs.loc[~designs[names].round(9).duplicated()].reset_index(drop=True)
-    quantity = spec.output or spec.check
-    U, q = [], []
-    for _, row in designs.iterrows():
-        ev = cp.evaluate(row[names].to_numpy(float))
-        U.append(ev.value)
-        q.append(float(np.max(ev.g)) if spec.output is not None else -float(ev.g[0]))
-    designs["U"], designs[quantity] = U, q
-    sense = {"U": "min", quantity: "max" if spec.check is not None else "min"}
-    designs["nondominated"] = nondominated(designs, ["U", quantity], sense)
-    return designs
-
-
-def tradeoff_table(problem: MinimaxProblem, setup: ModelSetup, objective: ResponseTarget, spec: TradeoffSpec,
-                   band: tuple[float, float], starts: pd.DataFrame, seed: int, client=None,
-                   after_check: dict | None = None) -> Tradeoff:
-    """The sweep of ``spec`` (:func:`sweep_designs`), its front, and the best front design meeting the check."""
-    table = sweep_designs(problem, setup, objective, spec, band, starts, seed, client)
-    quantity = spec.output or spec.check
-    front = table[table["nondominated"]].sort_values("U")
-    result = Tradeoff(spec, table, front, quantity, after_check)
-    if result.flagged:
-        ok = front[front[quantity] > after_check.get("required_speed_m_s", np.nan)]
+def sweep(problems: Sequence[tuple[float, MinimaxProblem]], spec: TradeoffSpec, seed: int,
+          points: Sequence[Sequence[float]] | None = None, client=None) -> pd.DataFrame:
+    """Solve each target's constrained problem from ``spec.n_starts`` Sobol starts (plus ``points``): one row per
+    target with the best feasible converged design (``success`` False and NaN where none was found)."""
+    names = list(problems[0][1].space.names)
+    rows = []
+    for target, problem in problems:
+        table = multistart(problem, spec.n_starts, method=spec.method, seed=seed, points=points, client=client)
+        ok = table[table["success"]]
+        row = {"epsilon": target, "success": bool(len(ok)), "value": np.nan, **{n: np.nan for n in names}}
         if len(ok):
-            result = Tradeoff(spec, table, front, quantity, after_check, ok.sort_values("U").iloc[0])
-    return result
+            best = ok.sort_values(["value", "start_id"]).iloc[0]
+            row |= {"value": float(best["value"]), **{n: float(best[n]) for n in names}}
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
-def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, optimum: np.ndarray, client=None) -> TradeoffSurfaces:
-    """The constrained and unconstrained :class:`~railopt.design.Surface` of U over ``spec.variables``."""
+def distinct_designs(designs: pd.DataFrame, problem: MinimaxProblem) -> pd.DataFrame:
+    """One row per distinct design (unit-cube coordinates equal to 1e-6), the first of each kept, with ``count``."""
+    names = list(problem.space.names)
+    u = np.round(np.array([problem.space.to_u(x) for x in designs[names].to_numpy(float)]), DISTINCT_DIGITS)
+    key = pd.Series([tuple(r) for r in u], index=designs.index)
+    counts = key.map(key.value_counts())
+    keep = ~key.duplicated()
+    return designs.loc[keep].assign(count=counts[keep].to_numpy()).reset_index(drop=True)
+
+
+def tradeoff_table(spec: TradeoffSpec, problems: Sequence[tuple[float, MinimaxProblem]], starts: pd.DataFrame,
+                   quantity: Callable[[np.ndarray], float], objective: Callable[[np.ndarray], float], seed: int,
+                   points: Sequence[Sequence[float]] | None = None, client=None,
+                   required: float | None = None) -> Tradeoff:
+    """The sweep of ``spec`` over its targets, merged with the campaign's starts; U (``objective``, certified) and
+    the traded ``quantity`` of every distinct design; the front; and, with ``required``, the best front design
+    whose quantity meets it."""
+    names = list(problems[0][1].space.names)
+    swept = sweep(problems, spec, seed, points, client)
+    designs = pd.concat([swept[swept["success"]][names].assign(source="sweep"),
+                         starts[np.isfinite(starts["value"])][names].assign(source="start")], ignore_index=True)
+    table = distinct_designs(designs, problems[0][1])
+    name = spec.output or "critical_speed_m_s"
+    table["U"] = [objective(x) for x in table[names].to_numpy(float)]
+    table[name] = [quantity(x) for x in table[names].to_numpy(float)]
+    table = table[np.isfinite(table["U"])].reset_index(drop=True)
+    at_least = spec.check is not None
+    table["nondominated"] = nondominated(table, ["U", name], {"U": "min", name: "max" if at_least else "min"})
+    front = table[table["nondominated"]].sort_values("U").reset_index(drop=True)
+    pick = None
+    if required is not None:
+        meets = front[front[name] >= required] if at_least else front[front[name] <= required]
+        pick = meets.sort_values("U").iloc[0] if len(meets) else None
+    return Tradeoff(spec, table, front, name, required, pick)
+
+
+@dataclass(frozen=True)
+class _GridRow:
+    """One row of a constraint grid (a task): ``fn`` at ``xi`` × one ``xj`` with the others at ``base``."""
+
+    fn: Callable[[np.ndarray], np.ndarray]
+    base: np.ndarray
+    i: int
+    j: int
+    xi: np.ndarray
+    xj_value: float
+
+    def __call__(self) -> tuple[float, np.ndarray]:
+        out = []
+        for v in self.xi:
+            x = self.base.copy()
+            x[self.i], x[self.j] = v, self.xj_value
+            out.append(self.fn(x))
+        return self.xj_value, np.array(out)
+
+
+def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, base: np.ndarray, client=None,
+             constraints: Callable[[np.ndarray], np.ndarray] | None = None,
+             limits: Sequence[tuple[str, float, bool]] = (),
+             marks: dict[str, dict[str, float]] | None = None) -> TradeoffSurfaces:
+    """The constrained and unconstrained :class:`~railopt.design.Surface` of U over ``spec.variables`` (the others
+    at ``base``), and on the constrained grid the values of ``constraints(x) -> (len(limits),)`` with their
+    ``limits`` ``(label, limit, at_least)``."""
     space = problem.space
-    grids = []
+    grids, axes_used = [], []
     for relaxed in (False, True):
         axes = []
         for name in spec.variables:
@@ -122,5 +156,15 @@ def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, optimum: np.ndarray, cl
             if relaxed:
                 lo = lo * spec.relax
             axes.append(np.geomspace(lo, hi, spec.points) if lo > 0 else np.linspace(lo, hi, spec.points))
-        grids.append(objective_surface(problem, spec.variables, axes[0], axes[1], optimum, client=client))
-    return TradeoffSurfaces(spec, grids[0], grids[1])
+        axes_used.append(axes)
+        grids.append(objective_surface(problem, spec.variables, axes[0], axes[1], base, client=client))
+    boundaries = []
+    if constraints is not None and limits:
+        i, j = (space.names.index(n) for n in spec.variables)
+        xi, xj = axes_used[0]
+        tasks = [_GridRow(constraints, np.asarray(base, dtype=float), i, j, xi, float(v)) for v in xj]
+        rows = dict(map_unordered(call, tasks, client=client))
+        values = np.array([rows[float(v)] for v in xj])  # (len(xj), len(xi), len(limits))
+        boundaries = [Boundary(label, values[:, :, k], limit, at_least)
+                      for k, (label, limit, at_least) in enumerate(limits)]
+    return TradeoffSurfaces(spec, grids[0], grids[1], boundaries, dict(marks or {}))
