@@ -25,7 +25,7 @@ from pathlib import Path
 
 from railopt import __version__
 from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV, scheduler_timeout
-from railopt.studies.config import ConfigError, load_study, read_toml, reference_markdown
+from railopt.studies.config import ConfigError, load_study, read_toml
 from railopt.studies.kind import StudyContext, StudyKind
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.publish import (
@@ -184,6 +184,8 @@ def cmd_vehicle(args: argparse.Namespace) -> int:
 
 
 def cmd_reference(args: argparse.Namespace) -> int:
+    from railopt.studies.reference import reference_markdown
+
     text = reference_markdown()
     if args.out is None:
         sys.stdout.write(text)
