@@ -103,16 +103,20 @@ def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower
     Newton steps on the local parabola: each step samples x ± h (one call of ``fun`` for every bracket) and moves
     to the vertex of the parabola through the three points of φ = 1/f² (``positive``; exactly a parabola near a
     resonance of one pole, see :func:`cell_maxima`) or of −f, with h the length of the last step (at least
-    10·tol), so the steps contract superlinearly.  A bracket is done when a step is below tol (Brent's
-    ``rtol``·width/3, as in :func:`bracketed_maximum`).  Returns ``(x, ok)``; ``ok`` is False where a step
-    would leave the bracket or the parabola is not convex (the caller refines those by Brent).
+    10·tol), so the steps contract superlinearly; a start within a quarter of the bracket from its ends starts
+    mid-way instead.  A bracket is done when a step is below tol (Brent's ``rtol``·width/3, as in
+    :func:`bracketed_maximum`) from a parabola fitted over at most 100·tol.  Returns ``(x, ok)``; ``ok`` is False
+    where a step would leave the bracket or the parabola is not convex (the caller refines those by Brent).
     """
     lo = np.asarray(lower, dtype=float)
     hi = np.asarray(upper, dtype=float)
     x = np.asarray(x0, dtype=float).copy()
     tol = np.maximum(rtol * (hi - lo), 4 * np.finfo(float).eps * np.maximum(np.abs(lo), np.abs(hi))) / 3.0
     ok = np.zeros(x.size, dtype=bool)
-    live = np.flatnonzero((x > lo) & (x < hi))  # a best sample on the bracket's end goes to Brent
+    # a start near an end of its bracket would fit the parabola over a sliver: start such brackets mid-way
+    quarter = 0.25 * (hi - lo)
+    x = np.where((x - lo > quarter) & (hi - x > quarter), x, 0.5 * (lo + hi))
+    live = np.flatnonzero(hi > lo)
     h = 0.5 * np.minimum(x - lo, hi - x)[live]
     for _ in range(VERTEX_ITERATIONS):
         if live.size == 0:
@@ -131,7 +135,8 @@ def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower
         good = (np.isfinite(phi).reshape(3, k).all(axis=0) & (den > 0) & (dl > 0) & (dr > 0)
                 & (step > a - xl) & (step < b - xl))
         new = xl + np.where(good, step, 0.0)
-        done = good & (np.abs(step) <= tol[live])
+        # done: a step below tol from a parabola fitted over ≤ 100·tol (its vertex is then exact to far below tol)
+        done = good & (np.abs(step) <= tol[live]) & (h <= 100.0 * tol[live])
         ok[live[done]] = True
         x[live[good]] = new[good]
         keep = good & ~done
