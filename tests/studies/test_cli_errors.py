@@ -388,3 +388,15 @@ def test_load_study_error_is_a_config_error_naming_the_file(tmp_path):
     path.write_text(path.read_text().replace("seed = 2002", f"seed = {2**64}"))
     with pytest.raises(ConfigError, match=rf"^{re.escape(str(path))}: design\.seed: must be at most"):
         load_study(path)
+
+
+def test_progress_on_a_terminal_redraws_at_most_once_per_minimum_interval():
+    """A redraw per finished start bypassed tqdm's minimum interval (112 redraws for 100 starts)."""
+    stream = io.StringIO()
+    bar = Progress("c", stream=stream, terminal=True, mininterval=60.0)
+    for done in range(1, 101):
+        bar.update(done, 100)
+    bar.close()
+    text = stream.getvalue()
+    assert text.count("\r") <= 3, text
+    assert "100%" in text.split("\r")[-1]
