@@ -113,27 +113,37 @@ class PoleResidue:
 
         return magnitude
 
-    def evaluate(self, omega: np.ndarray) -> np.ndarray:
-        """``H`` at frequencies ``omega`` (rad/s, 1-D), shape (len(omega), m); inf at a pole."""
+    def evaluate(self, omega: np.ndarray, outputs: list[int] | None = None) -> np.ndarray:
+        """``H`` at frequencies ``omega`` (rad/s, 1-D), shape (len(omega), m); inf at a pole.  ``outputs``: only
+        these output columns, in that order (default all)."""
         w = np.asarray(omega, dtype=float).ravel()
         iw = 1j * w
         with np.errstate(divide="ignore", invalid="ignore"):
             P = 1.0 / (iw[:, None] - self.poles[None, :])
         k, m, T, J = self._R.shape
+        cols = list(range(m)) if outputs is None else list(outputs)
+        R = self._R if outputs is None else self._R[:, cols]
+        m = len(cols)
         H = np.zeros((len(w), m), dtype=complex)
         if T:
-            S = (P @ self._R.reshape(k, m * T * J)).reshape(len(w), m, T, J)
-            phase = np.exp(-1j * np.outer(w, self._delays))  # (N, T)
-            powers = iw[:, None] ** np.arange(J)[None, :]  # (N, J)
-            H += np.einsum("nmtj,nt,nj->nm", S, phase, powers)
+            S = (P @ R.reshape(k, m * T * J)).reshape(len(w), m, T, J)
+            if J > 1:
+                S = np.einsum("nmtj,nj->nmt", S, iw[:, None] ** np.arange(J)[None, :])
+            else:
+                S = S[..., 0]
+            if np.any(self._delays != 0.0):
+                H += np.einsum("nmt,nt->nm", S, np.exp(-1j * np.outer(w, self._delays)))
+            else:
+                H += S.sum(axis=2)
         for t in self._callables:
             A = np.array([t.function(float(x)) for x in w], dtype=complex)  # (N, n)
             BA = A @ self._B.T  # (N, 2n)
-            H += ((P * BA) @ self._Cv.T) * np.exp(-1j * w * t.delay)[:, None]
-        for o, d in enumerate(self._feedthroughs):  # the input's own part of the output: no poles
+            H += ((P * BA) @ self._Cv[cols].T) * np.exp(-1j * w * t.delay)[:, None]
+        for i, o in enumerate(cols):  # the input's own part of the output: no poles
+            d = self._feedthroughs[o]
             if d is not None:
-                H[:, o] += d.values(w)[:, 0]
+                H[:, i] += d.values(w)[:, 0]
         with np.errstate(invalid="ignore", over="ignore"):
-            H *= iw[:, None] ** self.orders[None, :]
+            H *= iw[:, None] ** self.orders[cols][None, :]
         H[~np.isfinite(H)] = np.inf
         return H

@@ -194,12 +194,12 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
     resonant = undamped & (wd >= lo) & (wd <= hi)
     if not exact:
         freqs = np.concatenate([clipped, edges])
-        H = _finite_or_inf(np.abs(_direct(system, np.concatenate([clipped_eval, edges_eval]))))
+        H = _finite_or_inf(np.abs(_direct(system, np.concatenate([clipped_eval, edges_eval]), cols)))
         if lo_eval > lo:  # the limit Ω → 0 at the lower edge (and at modes clipped to it)
             H[np.concatenate([clipped_eval, edges_eval]) == lo_eval] = at_zero
         out = {}
-        for nm, c in zip(names, cols, strict=True):
-            vals = H[:, c].copy()
+        for i, nm in enumerate(names):
+            vals = H[:, i].copy()
             vals[: len(wd)][resonant] = np.inf
             out[nm] = ResponseMaxima(vals, freqs, wd, (lo, hi), exact=False, output=nm)
         return out
@@ -220,7 +220,7 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
     cell_f, cell_x, all_finite, edge_vals = result
     if lo_eval > lo:  # the limit Ω → 0: the lower edge's value, and the first cell's if it is larger
         edge_vals[0] = at_zero
-        first = at_zero[cols]
+        first = at_zero
         larger = first > cell_f[:, 0]
         cell_f[larger, 0], cell_x[larger, 0] = first[larger], lo_eval
     spacing = ratio <= CERTIFIED_RATIO * (1 + 1e-9)
@@ -230,13 +230,13 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
         (spacing, f"the grid broke the spacing rule (ratio {ratio:.3g})"),
         (all_finite, "a sample was singular (an undamped or rigid-body pole on the band)")) if not ok)
     out = {}
-    for i, (nm, c) in enumerate(zip(names, cols, strict=True)):
+    for i, nm in enumerate(names):
         f, x = cell_f[i].copy(), cell_x[i].copy()
         f[resonant] = np.inf
         x[resonant] = clipped[resonant]
         x[x == lo_eval] = lo  # the limit Ω → 0 is reported at 0
         out[nm] = ResponseMaxima(
-            np.concatenate([f, edge_vals[:, c]]), np.concatenate([x, edges]), wd, (lo, hi), exact=True,
+            np.concatenate([f, edge_vals[:, i]]), np.concatenate([x, edges]), wd, (lo, hi), exact=True,
             certified=certified, grid_ratio=ratio, output=nm,
             evaluation="direct" if pr is None else "pole-residue", grid_points=len(grid), reason=reason,
         )
@@ -262,8 +262,8 @@ def _zero_limit(system: LinearSystem, names: list[str], cols: list[int], hi: flo
     if scale == 0.0 or not np.any(neutral):
         return 0.0, None
     eps = min(ZERO_STEP * float(np.min(np.abs(s[~neutral]))), 1e-3 * hi)
-    H = _direct(system, np.array([eps, 2 * eps, 0.1 * eps]))
-    mags = np.abs(H)[:, cols]
+    H = _direct(system, np.array([eps, 2 * eps, 0.1 * eps]), cols)
+    mags = np.abs(H)
     growing = ~np.isfinite(mags[2]) | (mags[2] > 1.5 * mags[0] + 1e-300)
     if np.any(growing):
         bad = [nm for nm, g in zip(names, growing, strict=True) if g]
@@ -276,50 +276,53 @@ def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
                  edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool, np.ndarray] | None:
     """Cell maxima (values by direct solves at the refined frequencies) for each output column, and |H| at
     the band edges (the same batch of direct solves)."""
-    sample = (lambda w: _direct(system, w)) if pr is None else pr.evaluate
-    mags = _finite_or_inf(np.abs(sample(grid)))
+    H = _direct(system, grid, cols) if pr is None else pr.evaluate(grid, outputs=cols)
+    mags = _finite_or_inf(np.abs(H))
     xs, fs = [], []
-    for c in cols:  # per output (usually one); the cells of each are refined all at once
+    for i, c in enumerate(cols):  # per output (usually one); the cells of each are refined all at once
         fun = pr.magnitude_function(c) if pr is not None else (
-            lambda w, c=c: _finite_or_inf(np.abs(_direct(system, w)[:, c])))
-        x, f = cell_maxima(fun, grid, mags[:, c], bounds)
+            lambda w, c=c: _finite_or_inf(np.abs(_direct(system, w, [c])[:, 0])))
+        x, f = cell_maxima(fun, grid, mags[:, i], bounds)
         xs.append(x)
         fs.append(f)
     X = np.array(xs)
-    direct = _finite_or_inf(np.abs(_direct(system, np.concatenate([X.ravel(), edges]))))
+    direct = _finite_or_inf(np.abs(_direct(system, np.concatenate([X.ravel(), edges]), cols)))
     edge_vals, direct = direct[-len(edges):], direct[: -len(edges)]
-    F = np.array([direct[i * X.shape[1]:(i + 1) * X.shape[1], c] for i, c in enumerate(cols)])
+    F = np.array([direct[i * X.shape[1]:(i + 1) * X.shape[1], i] for i in range(len(cols))])
     if pr is not None:
         sampled = np.array(fs)
         ok = np.isfinite(sampled) & np.isfinite(F)
         scale = np.max(np.where(ok, F, 0.0), initial=0.0)
         if np.any(np.abs(sampled[ok] - F[ok]) > CONSISTENCY_RTOL * max(scale, 1e-300)):
             return None
-    return F, X, bool(np.all(np.isfinite(mags[:, cols]))), edge_vals
+    return F, X, bool(np.all(np.isfinite(mags))), edge_vals
 
 
-def _direct(system: LinearSystem, w: np.ndarray) -> np.ndarray:
-    """``system.frf_outputs(omega_rad_s=w)`` (the same batched solves ``Z(Ω)X = F``) with the polynomial forcing
-    evaluated for all Ω at once; anything unusual (a callable term, a non-finite F or Z, a singular Z) goes to
-    ``frf_outputs`` itself, which handles or names it."""
+def _direct(system: LinearSystem, w: np.ndarray, cols: list[int]) -> np.ndarray:
+    """``system.frf_outputs(omega_rad_s=w)[:, cols]`` (the same batched solves ``Z(Ω)X = F``) with the polynomial
+    forcing evaluated for all Ω at once and only the outputs ``cols``; anything unusual (a callable term, a
+    non-finite F or Z, a singular Z) goes to ``frf_outputs`` itself, which handles or names it."""
     forcing = system.forcing
     if not forcing.is_polynomial:
-        return system.frf_outputs(omega_rad_s=w)
+        return system.frf_outputs(omega_rad_s=w)[:, cols]
     w = np.asarray(w, dtype=float).ravel()
     F = forcing.values(w)
     with np.errstate(over="ignore", invalid="ignore"):
         Z = (system.K[None] - w[:, None, None] ** 2 * system.M[None]) + 1j * w[:, None, None] * system.C[None]
     if not (np.isfinite(F).all() and np.isfinite(Z).all()):
-        return system.frf_outputs(omega_rad_s=w)
+        return system.frf_outputs(omega_rad_s=w)[:, cols]
     try:
         X = np.linalg.solve(Z, F[..., None])[..., 0]
     except np.linalg.LinAlgError:
-        return system.frf_outputs(omega_rad_s=w)
-    outputs = system.outputs.values()
-    rows = np.array([o.row for o in outputs])
-    orders = np.array([o.order for o in outputs])
+        return system.frf_outputs(omega_rad_s=w)[:, cols]
+    outputs = list(system.outputs.values())
+    chosen = [outputs[c] for c in cols]
+    rows = np.array([o.row for o in chosen])
+    orders = np.array([o.order for o in chosen])
+    feed = 0.0 if all(o.feedthrough is None for o in chosen) else np.column_stack(
+        [o.feedthrough_values(w) for o in chosen])  # as LinearSystem._feedthroughs, for these outputs
     with np.errstate(over="ignore", invalid="ignore"):
-        H = (X @ rows.T + system._feedthroughs(w)) * (1j * w[:, None]) ** orders[None, :]
+        H = (X @ rows.T + feed) * (1j * w[:, None]) ** orders[None, :]
     H[~np.isfinite(H)] = np.inf
     return H
 
