@@ -265,7 +265,11 @@ def _one_line(exc: BaseException) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["vehicle"]:  # its own options (--speed, --help) go to the vehicle hook, in any order
+        args = argparse.Namespace(command="vehicle", func=cmd_vehicle, argv=argv[1:])
+    else:
+        args = build_parser().parse_args(argv)
     in_main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
     try:

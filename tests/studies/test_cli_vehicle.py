@@ -99,3 +99,14 @@ def test_unknown_vehicle_name_exits_2_with_one_line():
     assert done.returncode == 2
     assert done.stderr == ("railopt: error: sd40-3: no such vehicle file; bundled vehicles: sd40-2, single-wheelset, "
                            "manchester-coach\n")
+
+
+def test_vehicle_options_before_the_name_and_help():
+    done, _ = run_cli("vehicle", "--speed", "30", "--track", "rigid", "single-wheelset")
+    assert done.returncode == 0, done.stderr
+    assert "Lateral modes at 30 m/s, rigid track" in done.stdout
+    helped, _ = run_cli("vehicle", "--help")
+    assert helped.returncode == 0 and helped.stdout.startswith("usage: railopt vehicle [-h] [--speed SPEED]")
+    usage, _ = run_cli("vehicle")
+    assert usage.returncode == 2
+    assert usage.stderr.splitlines()[-1] == "railopt vehicle: error: the following arguments are required: vehicle"
