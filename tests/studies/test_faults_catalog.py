@@ -129,9 +129,6 @@ def test_frf_design_with_a_negative_damping_ratio_is_refused(tmp_path):
     refused(path, "designs[2].values.damping_ratio: a damping ratio cannot be below 0, got -0.02")
 
 
-@pytest.mark.xfail(strict=True, reason="needs setup.parameter_map.check_variables(cfg.design.variables) in "
-                                       "studies/kinds/campaign/config.py::_check_setup (the lead's file); "
-                                       "remove this marker once it is there")
 def test_campaign_with_negative_stiffness_bound_is_refused(tmp_path):  # F02
     path = flagship(tmp_path, {"lower = 1.0e5\nupper = 5.0e6\nscale = \"log\"":
                                "lower = -1.0e6\nupper = 5.0e6\nscale = \"linear\""})

@@ -12,7 +12,7 @@ from pydantic import Field, field_validator, model_validator
 from railopt.design import DesignVariable
 from railopt.models.units import RAD_PER_HZ
 from railopt.studies.adapter import ResponseTarget, StabilityTarget
-from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
+from railopt.studies.catalog import ModelSetup, ModelsStudy, PositiveInterval, require_unique
 from railopt.studies.config import BandHz, FiniteModel, MethodName, StrictModel
 
 __all__ = [
@@ -168,7 +168,7 @@ class ReportSpec(StrictModel):
     before: str | None = Field(None, description="a named design reported before/after against the best optimum")
     outputs: list[str] = Field(default_factory=list, description="outputs shown before/after (default: objective)")
     inch_outputs: list[str] = Field(default_factory=list, description="outputs also reported in inches (m → in)")
-    locus_speeds_m_s: tuple[float, float] | None = Field(None, description="root locus before/after over speed")
+    locus_speeds_m_s: PositiveInterval | None = Field(None, description="root locus before/after over speed, m/s")
     published: dict[str, tuple[float, float]] = Field(
         default_factory=dict, description="output -> published (before, after) peaks, in inches for inch_outputs")
     frf_points: int = Field(800, ge=50, le=20000)
@@ -235,6 +235,7 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
     bad = [n for n in names if n not in setup.designable]
     if bad:
         raise ValueError(f"design.variables: {bad} are not parameters of {where}; choose from {list(setup.designable)}")
+    setup.parameter_map.check_variables(cfg.design.variables)  # stiffness, damping, mass, inertia ≥ 0
     outputs = setup.family.output_names
     specs = [("objective", cfg.objective)] + [(f"constraints[{i}]", c) for i, c in enumerate(cfg.constraints)]
     for field, spec in specs:

@@ -93,7 +93,7 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
           f"(4.71)–(4.73) reads {ba.thesis:.5g} at this optimum against the certified maximum {ba.exact:.5g} "
           f"({100 * (ba.thesis - ba.exact) / ba.exact:+.2f} %).", ""]
     for o, f_hz, before, after, unit in ba.frfs:
-        fig = plot_before_after(f_hz, before, after, f"{model}: {o} before and after optimisation", f"|{o}| ({unit})")
+        fig = plot_before_after(f_hz, before, after, f"{model}: {o} before and after optimisation", unit)
         name = writer.figure(fig, f"{o}_before_after{tag}", dpi=dpi)
         md += [f"![{o}]({name})", ""]
     if ba.stability is not None:

@@ -224,7 +224,7 @@ def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], compari
             curves.append((f"{label} (peak {r['true_peak']:.6g})", f_hz,
                            np.abs(setup.family.at(p).frf(frequencies_hz=f_hz, output=target.output)),
                            r["objective"]))
-        panels.append((f"{model}: {setup.description}", f"|H| of {target.output}", curves))
+        panels.append((f"{model}: {setup.description}", setup.axis_label(target.output), curves))
     return panels
 
 
@@ -397,13 +397,12 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
     f_hz = np.linspace(band[0] / HZ, band[1] / HZ, cfg.report.frf_points)
     frfs = []
     for o in outputs:
-        suffix = {"displacement": "", "velocity": "/s", "acceleration": "/s²"}[sys_a.outputs[o].quantity]
         inch = o in cfg.report.inch_outputs
         before = np.abs(sys_b.frf(frequencies_hz=f_hz, output=o))
         after_h = np.abs(sys_a.frf(frequencies_hz=f_hz, output=o))
         if inch:
             before, after_h = m_to_in(before), m_to_in(after_h)
-        frfs.append((o, f_hz, before, after_h, f"in{suffix}" if inch else "SI units"))
+        frfs.append((o, f_hz, before, after_h, setup.axis_label(o, inch=inch)))
     loci = None
     if cfg.report.locus_speeds_m_s is not None:
         speeds = np.linspace(*cfg.report.locus_speeds_m_s, 80)

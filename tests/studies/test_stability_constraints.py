@@ -1,0 +1,149 @@
+"""Stability as a design constraint in campaigns (issue 14): the constrained optimum against a dense grid, no
+unstable best, the warning on an unstable existing design, the hunting check on a forced vehicle model."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from railopt.design import multistart
+from railopt.models.stability import abscissa, root_constraints
+from railopt.studies.cli import STUDIES_DIR
+from railopt.studies.config import load_study
+from railopt.studies.kinds.campaign.run import campaign_problem, warnings
+
+TWO = '''
+[[design.variables]]
+name = "lateral_shock_absorber_damping"
+lower = 5.0e4
+upper = 5.6e4
+scale = "log"
+
+[[design.variables]]
+name = "rotational_shock_absorber_damping"
+lower = 1.0e4
+upper = 1.5e4
+scale = "log"
+'''
+
+
+def two_variable_flagship(tmp_path):
+    """The flagship with K2, K3 at the recommended corner and (C13, C15) designed; rigid track, 3 speeds.  U rises
+    steeply with C13 where the stability rows are active (dU/dln C13 ≈ U/2), so the box around the constrained
+    optimum is narrow enough for a 100 × 100 grid to resolve it to 1e-3."""
+    text = (STUDIES_DIR / "cab_lateral_minimax.toml").read_text()
+    head, _, rest = text.partition("[[design.variables]]")
+    rest = rest[rest.index("[design.options]"):]
+    text = head + TWO + "\n" + rest[: rest.index("[report]")]
+    text = text.replace("max_operating_speed_mph = 70.0 }",
+                        "max_operating_speed_mph = 70.0, parameters = { K2 = 1.0e5, K3 = 2.0e8 } }")
+    text = text.replace("speeds = 12 ", "speeds = 3 ")
+    text = text.replace("sigma_min = 0.005", 'sigma_min = 0.005\ntracks = ["rigid"]')
+    text = text.replace('start_from = ["existing"]', "start_from = []")
+    path = tmp_path / "two.toml"
+    path.write_text(text)
+    return load_study(path)[1]
+
+
+@pytest.mark.slow
+def test_the_constrained_optimum_is_the_best_feasible_point_of_a_dense_grid(tmp_path) -> None:
+    cfg = two_variable_flagship(tmp_path)
+    setup = cfg.setups()["sd40-2"]
+    problem = campaign_problem(cfg, setup, "exact", "constrained")
+    table = multistart(problem, 4, method="slsqp", seed=3, options={"xtol": 1e-10, "ftol": 1e-12, "maxeval": 500})
+    best = table[table["success"]].sort_values("value").iloc[0]
+    x_opt = best[list(problem.space.names)].to_numpy(float)
+    ev = problem.evaluate(x_opt)
+    assert problem.constraint_violation(x_opt, ev) <= 1e-9  # every constraint met to its tolerance
+    # the dense grid (100 × 100, log-spaced over the bounds): feasible where every root (none is a track mode on
+    # rigid track; neutral roots aside) has Re s + σ ≤ 0 at the grid's speeds — eigenvalues alone — U there
+    family = setup.stability["rigid"]
+    speeds = cfg.stability.target(setup).speeds
+    names = [v.name for v in cfg.design.variables]
+    grid = [np.geomspace(v.lower, v.upper, 100) for v in cfg.design.variables]
+    params = list(setup.family.parameters)
+    rows = [params.index(n) for n in family.parameters]
+    g_opt, _ = root_constraints(family, setup.parameters(names, x_opt)[0][rows], speeds, cfg.stability.sigma_min)
+    assert np.max(g_opt) <= 1e-9
+    objective = campaign_problem(cfg, setup, "exact", "unconstrained")  # U alone, no constraint rows
+    feasible_U = []
+    for a in grid[0]:
+        for b in grid[1]:
+            p, _ = setup.parameters(names, np.array([a, b]))
+            worst = max(abscissa(family.at(p[rows], speed=S).eigenvalues()) for S in speeds)
+            if worst + cfg.stability.sigma_min <= 0.0:
+                feasible_U.append(objective.value([a, b]))
+    assert len(feasible_U) > 100
+    grid_best = min(feasible_U)
+    assert ev.value <= grid_best * (1 + 1e-9)  # nothing on the grid beats the optimum
+    assert abs(ev.value - grid_best) <= 1e-3 * grid_best
+
+
+COACH = '''
+[study]
+name = "coach_hunting"
+kind = "campaign"
+
+[[models]]
+label = "coach"
+model = "vehicle_forced"
+options = {{ vehicle = "manchester-coach", view = "lateral", speed_m_s = {speed}, track = "rigid", {rest} }}
+
+[objective]
+output = "cab.lateral"
+band_hz = [0.5, 8.0]
+
+[design]
+methods = ["slsqp"]
+objectives = ["exact"]
+n_starts = 6
+seed = 5
+{starts}
+checks = ["hunting"]
+
+[[design.variables]]
+name = "kpx"
+lower = 1.0e6
+upper = 3.0e8
+scale = "log"
+'''
+
+
+def coach_study(tmp_path, speed: float, starts: str = 'start_from = ["existing"]'):
+    path = tmp_path / f"coach{speed:g}.toml"
+    rest = ('input = { kind = "alignment", amplitude_m = 0.001 }, outputs = ["cab.lateral"], '
+            f'quantity = "acceleration", max_operating_speed_m_s = {speed}')
+    path.write_text(COACH.format(speed=speed, rest=rest, starts=starts))
+    return path
+
+
+def test_an_existing_design_that_hunts_is_warned_of(tmp_path) -> None:
+    _, cfg, _ = load_study(coach_study(tmp_path, 85.0))  # the coach hunts from 79.9 m/s
+    found = warnings(cfg)
+    assert len(found) == 1
+    assert found[0].startswith("models[0] (coach): the existing design fails the 'hunting' check (stable is false")
+    _, cfg, _ = load_study(coach_study(tmp_path, 60.0))
+    assert warnings(cfg) == []
+
+
+@pytest.mark.slow
+def test_a_campaign_from_an_unstable_design_reports_no_unstable_best(tmp_path) -> None:
+    """At 78 m/s, from a design that hunts from 29.5 m/s (kpx = 1 MN/m; the file's 31.4 MN/m is stable to 79.9):
+    U is inf for every unstable design (no steady state), the hunting check runs on every optimum of a
+    vehicle_forced model, and the best reported design passes it."""
+    from railopt.studies.cli import main
+
+    study = coach_study(tmp_path, 78.0, "points = [{ kpx = 1.0e6 }]")
+    assert main(["run", str(study), "--results", str(tmp_path / "r"), "--workers", "0", "--no-progress"]) == 0
+    import pandas as pd
+
+    out = tmp_path / "r" / "coach_hunting"
+    starts = pd.read_csv(out / "starts.csv")
+    assert np.isinf(starts.loc[starts["start_id"] == 0, "value"]).all()  # the existing (unstable) start
+    optima = pd.read_csv(out / "optima.csv")
+    assert "hunting" in optima.columns and "critical_speed_rigid_m_s" in optima.columns
+    comparison = pd.read_csv(out / "comparison.csv").iloc[0]
+    assert np.isfinite(comparison["true_peak"])
+    best = optima[optima["start_id"] == comparison["best_start"]].iloc[0]
+    assert bool(best["stable"]) and best["critical_speed_rigid_m_s"] > 78.0
+    assert int(comparison["failing_optima"]) == int((~optima["stable"].astype(bool)).sum())
