@@ -266,3 +266,28 @@ def test_flagship_runs_on_a_separately_started_dask_cluster(tmp_path):
     a = pd.read_csv(tmp_path / "cluster" / "cab_lateral_minimax" / "starts.csv")
     b = pd.read_csv(tmp_path / "serial" / "cab_lateral_minimax" / "starts.csv")
     pd.testing.assert_frame_equal(a[cols], b[cols])
+
+
+@pytest.mark.slow
+def test_resume_with_more_starts_extends_the_campaign_and_names_other_changes(tmp_path):
+    """Issue 15: raising n_starts from 8 to 12 with --resume runs the 4 new starts only and keeps the first 9
+    (8 Sobol + the existing design) as they were; any other change is refused naming the field."""
+    study = small_flagship(tmp_path, n_starts=8, report=False)
+    results = tmp_path / "results"
+    args = ["run", str(study), "--results", str(results), "--workers", "0", "--no-progress"]
+    assert main(args) == 0
+    store = results / "cab_lateral_minimax" / "campaigns" / "sd40-2-exact-slsqp.sqlite"
+    with sqlite3.connect(store) as db:
+        before = db.execute("SELECT start_id, x_json, value, finished_utc FROM starts ORDER BY start_id").fetchall()
+    assert [r[0] for r in before] == list(range(9))
+    study.write_text(study.read_text().replace("n_starts = 8", "n_starts = 12"))
+    assert main([*args, "--resume"]) == 0
+    with sqlite3.connect(store) as db:
+        after = db.execute("SELECT start_id, x_json, value, finished_utc FROM starts ORDER BY start_id").fetchall()
+    assert [r[0] for r in after] == list(range(13))
+    assert after[:9] == before  # the finished starts are kept, not redone
+    study.write_text(study.read_text().replace("seed = 1975", "seed = 7"))
+    proc = subprocess.run([sys.executable, "-m", "railopt.studies.cli", *args, "--resume"], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 2
+    assert "was made from a different config: design.seed (1975 → 7)" in proc.stderr

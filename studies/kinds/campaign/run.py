@@ -5,6 +5,7 @@ but the campaign stores."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -556,6 +557,39 @@ class CampaignResult:
     existing_checks: dict[str, dict[str, dict]] = field(default_factory=dict)  # model -> check -> payload
 
 
+def _store_config(cfg: CampaignStudyConfig, key: tuple[str, str, str, str]) -> dict:
+    """What a campaign's store is made from: the whole config but the number of starts (a resume may extend a
+    campaign: the same seed and sampler give the same first starts, so only the new ones run)."""
+    model, kind, objective, method = key
+    dumped = cfg.model_dump(mode="json")
+    dumped["design"] = {k: v for k, v in dumped["design"].items() if k != "n_starts"}
+    return {**dumped, "campaign": {"model": model, "objective": objective, "method": method, "problem": kind}}
+
+
+def _flat(value: object, prefix: str = "") -> dict[str, object]:
+    if isinstance(value, dict):
+        out: dict[str, object] = {}
+        for k, v in value.items():
+            out |= _flat(v, f"{prefix}.{k}" if prefix else str(k))
+        return out
+    return {prefix: value}
+
+
+def _check_resumable(path: Path, config: dict) -> None:
+    """A store made from another config is refused naming the fields that differ (``n_starts`` may grow)."""
+    if not path.exists():
+        return
+    with CampaignStore.open(path) as store:
+        stored = store.config()
+    old, new = _flat(stored), _flat(json.loads(json.dumps(config, sort_keys=True, default=str)))
+    changed = sorted(k for k in old.keys() | new.keys() if old.get(k, "<absent>") != new.get(k, "<absent>"))
+    if changed:
+        shown = ", ".join(f"{k} ({old.get(k, '<absent>')!r} → {new.get(k, '<absent>')!r})" for k in changed[:6])
+        more = f" and {len(changed) - 6} more" if len(changed) > 6 else ""
+        raise ValueError(f"store: {path} was made from a different config: {shown}{more}; only design.n_starts may "
+                         "change on --resume (run with --fresh to discard the store)")
+
+
 def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str, str], context: StudyContext,
               client) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
     """One campaign (model, problem, objective, method): its starts, its checked distinct optima and their flags."""
@@ -564,8 +598,8 @@ def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, 
     problem = campaign_problem(cfg, setup, objective, kind)
     label = campaign_label(model, objective, method, kind)
     settings = cfg.design.model_copy(update={"method": method})
-    store_config = {**cfg.model_dump(mode="json"), "campaign": {"model": model, "objective": objective,
-                                                                 "method": method, "problem": kind}}
+    store_config = _store_config(cfg, key)
+    _check_resumable(store_path(context, label), store_config)
     table = run_campaign(problem, label, settings, context, store_config, client, _starts(cfg, setup))
     found = distinct_optima(table, problem).rename(columns={"best_start": "start_id"})
     flags: list[str] = []
