@@ -13,7 +13,7 @@ from railopt.design.result import STATUSES, SolveResult
 from railopt.design.solve import solve
 from railopt.design.starts import start_points
 from railopt.design.store import CampaignStore
-from railopt.design.surface import Surface, objective_surface
+from railopt.design.surface import Surface, grid_map, objective_surface
 from railopt.design.tradeoff import epsilon_sweep, nondominated
 from railopt.design.variables import DesignVariable
 
@@ -29,6 +29,7 @@ __all__ = [
     "check_designs",
     "dask_client",
     "epsilon_sweep",
+    "grid_map",
     "distinct_optima",
     "label_clusters",
     "map_unordered",

@@ -6,7 +6,7 @@ notes the trivial optimum at zero stiffness); ``constrained`` marks the points i
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -42,7 +42,9 @@ class Surface(ArrayRecord):
 
 @dataclass(frozen=True)
 class _Row:
-    problem: MinimaxProblem
+    """One row of a grid (a task): ``fn`` at x with ``x[i]`` over ``xi`` and ``x[j] = xj_value``, the rest ``base``."""
+
+    fn: Callable[[np.ndarray], object]
     base: np.ndarray
     i: int
     j: int
@@ -50,15 +52,44 @@ class _Row:
     xj_value: float
 
     def __call__(self) -> tuple[float, np.ndarray]:
-        out = np.empty(len(self.xi))
-        for k, v in enumerate(self.xi):
+        out = []
+        for v in self.xi:
             x = self.base.copy()
             x[self.i], x[self.j] = v, self.xj_value
-            try:
-                out[k] = self.problem.value(x)
-            except ValueError:  # e.g. a singular model at zero stiffness: no finite response
-                out[k] = np.inf
-        return self.xj_value, out
+            out.append(self.fn(x))
+        return self.xj_value, np.array(out, dtype=float)
+
+
+@dataclass(frozen=True)
+class _Value:
+    """U(x); +inf where the model refuses the design (e.g. a singular model at zero stiffness)."""
+
+    problem: MinimaxProblem
+
+    def __call__(self, x: np.ndarray) -> float:
+        try:
+            return self.problem.value(x)
+        except ValueError:
+            return np.inf
+
+
+def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], names: tuple[str, str],
+             xi: Sequence[float], xj: Sequence[float], base: Sequence[float], client: Any = None) -> np.ndarray:
+    """``fn(x)`` on the grid ``xi × xj`` of the two named variables (the others at ``base``), one task per grid
+    row: an array (len(xj), len(xi), …) — ``fn`` may return a number or a vector."""
+    space_names = list(space_names)
+    for n in names:
+        if n not in space_names:
+            raise ValueError(f"names: unknown design variable {n!r}; known: {tuple(space_names)}")
+    if names[0] == names[1]:
+        raise ValueError("names: need two different design variables")
+    i, j = space_names.index(names[0]), space_names.index(names[1])
+    base = np.asarray(base, dtype=float)
+    if base.shape != (len(space_names),) or not np.all(np.isfinite(base)):
+        raise ValueError(f"base: expected {len(space_names)} finite values")
+    xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
+    rows = dict(map_unordered(call, [_Row(fn, base, i, j, xi, float(v)) for v in xj], client=client))
+    return np.array([rows[float(v)] for v in xj])
 
 
 def objective_surface(
@@ -71,18 +102,9 @@ def objective_surface(
 ) -> Surface:
     """U over ``xi × xj`` for the two named variables, the others at ``base``; one task per grid row."""
     space = problem.space
-    for n in names:
-        if n not in space.names:
-            raise ValueError(f"names: unknown design variable {n!r}; known: {space.names}")
-    if names[0] == names[1]:
-        raise ValueError("names: need two different design variables")
+    values = grid_map(_Value(problem), space.names, names, xi, xj, base, client)
     i, j = space.names.index(names[0]), space.names.index(names[1])
-    base = np.asarray(base, dtype=float)
-    if base.shape != (space.dim,) or not np.all(np.isfinite(base)):
-        raise ValueError(f"base: expected {space.dim} finite values")
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
-    rows = dict(map_unordered(call, [_Row(problem, base, i, j, xi, float(v)) for v in xj], client=client))
-    values = np.array([rows[float(v)] for v in xj])
     inside_i = (xi >= space.lower[i]) & (xi <= space.upper[i])
     inside_j = (xj >= space.lower[j]) & (xj <= space.upper[j])
     return Surface(names, xi, xj, values, inside_j[:, None] & inside_i[None, :])

@@ -105,32 +105,32 @@ def poisson(name: str, value: object) -> float:
     return x
 
 
-AMBIGUOUS = object()  # the default of a positional band/frequency argument that must not be given
+def _in_rad_s(positional: object, in_hz: object, in_rad_s: object, names: tuple[str, str, str],
+              check: object) -> object:
+    """The one value of ``in_hz`` (converted ×2π) or ``in_rad_s``, checked by ``check(value, name, unit)``; a
+    positional value is ambiguous and refused naming ``names[0]``."""
+    positional_name, hz_name, rad_name = names
+    if positional is not None:
+        what = "band" if positional_name == "band" else "frequency"
+        raise ValueError(f"{positional_name}: a positional {what} is ambiguous (Hz or rad/s?); give "
+                         f"{hz_name}= in Hz or {rad_name}= in rad/s")
+    if (in_hz is None) == (in_rad_s is None):
+        raise ValueError(f"{hz_name}: give exactly one of {hz_name}= in Hz or {rad_name}= in rad/s")
+    if in_hz is not None:
+        return 2.0 * math.pi * np.asarray(check(in_hz, hz_name, "Hz"))
+    return check(in_rad_s, rad_name, "rad/s")
 
 
 def band_arg(positional: object = None, band_hz: object = None, band_rad_s: object = None) -> tuple[float, float]:
     """The one frequency convention of railopt's public API: a band is given as ``band_hz=(lo, hi)`` in Hz or
     ``band_rad_s=(lo, hi)`` in rad/s (exactly one); a positional ``band`` is refused, because (0.2, 5.0) in Hz
     read as rad/s gives a 13× different answer without any sign of it.  Returns (lo, hi) in rad/s."""
-    if positional is not None:
-        raise ValueError("band: a positional band is ambiguous (Hz or rad/s?); give band_hz=(lo, hi) in Hz or "
-                         "band_rad_s=(lo, hi) in rad/s")
-    if (band_hz is None) == (band_rad_s is None):
-        raise ValueError("band_hz: give exactly one of band_hz=(lo, hi) in Hz or band_rad_s=(lo, hi) in rad/s")
-    if band_hz is not None:
-        lo, hi = band(band_hz, "band_hz", "Hz")
-        return 2.0 * math.pi * lo, 2.0 * math.pi * hi
-    return band(band_rad_s, "band_rad_s")
+    lo, hi = _in_rad_s(positional, band_hz, band_rad_s, ("band", "band_hz", "band_rad_s"), band)
+    return float(lo), float(hi)
 
 
 def frequencies_arg(omega: object = None, frequencies_hz: object = None, omega_rad_s: object = None) -> np.ndarray:
     """Forcing frequencies as ``frequencies_hz=`` (Hz) or ``omega_rad_s=`` (rad/s), exactly one; a positional
     value is refused (see :func:`band_arg`).  Returns rad/s, 1-D."""
-    if omega is not None:
-        raise ValueError("omega: a positional frequency is ambiguous (Hz or rad/s?); give frequencies_hz= (Hz) or "
-                         "omega_rad_s= (rad/s)")
-    if (frequencies_hz is None) == (omega_rad_s is None):
-        raise ValueError("frequencies_hz: give exactly one of frequencies_hz= (Hz) or omega_rad_s= (rad/s)")
-    if frequencies_hz is not None:
-        return 2.0 * math.pi * frequencies_rad_s(frequencies_hz, "frequencies_hz")
-    return frequencies_rad_s(omega_rad_s, "omega_rad_s")
+    return np.asarray(_in_rad_s(omega, frequencies_hz, omega_rad_s, ("omega", "frequencies_hz", "omega_rad_s"),
+                                lambda value, name, unit: frequencies_rad_s(value, name)), dtype=float)

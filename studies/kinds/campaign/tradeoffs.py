@@ -21,8 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from railopt.design import MinimaxProblem, Surface, map_unordered, multistart, nondominated, objective_surface
-from railopt.design.parallel import call
+from railopt.design import MinimaxProblem, Surface, grid_map, multistart, nondominated, objective_surface
 from railopt.studies.kinds.campaign.config import SurfaceSpec, TradeoffSpec
 
 __all__ = ["Boundary", "Tradeoff", "TradeoffSurfaces", "distinct_designs", "surfaces", "sweep", "tradeoff_table"]
@@ -119,26 +118,6 @@ def tradeoff_table(spec: TradeoffSpec, problems: Sequence[tuple[float, MinimaxPr
     return Tradeoff(spec, table, front, name, required, pick)
 
 
-@dataclass(frozen=True)
-class _GridRow:
-    """One row of a constraint grid (a task): ``fn`` at ``xi`` × one ``xj`` with the others at ``base``."""
-
-    fn: Callable[[np.ndarray], np.ndarray]
-    base: np.ndarray
-    i: int
-    j: int
-    xi: np.ndarray
-    xj_value: float
-
-    def __call__(self) -> tuple[float, np.ndarray]:
-        out = []
-        for v in self.xi:
-            x = self.base.copy()
-            x[self.i], x[self.j] = v, self.xj_value
-            out.append(self.fn(x))
-        return self.xj_value, np.array(out)
-
-
 def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, base: np.ndarray, client=None,
              constraints: Callable[[np.ndarray], np.ndarray] | None = None,
              limits: Sequence[tuple[str, float, bool]] = (),
@@ -160,11 +139,8 @@ def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, base: np.ndarray, clien
         grids.append(objective_surface(problem, spec.variables, axes[0], axes[1], base, client=client))
     boundaries = []
     if constraints is not None and limits:
-        i, j = (space.names.index(n) for n in spec.variables)
         xi, xj = axes_used[0]
-        tasks = [_GridRow(constraints, np.asarray(base, dtype=float), i, j, xi, float(v)) for v in xj]
-        rows = dict(map_unordered(call, tasks, client=client))
-        values = np.array([rows[float(v)] for v in xj])  # (len(xj), len(xi), len(limits))
+        values = grid_map(constraints, space.names, spec.variables, xi, xj, base, client)  # (xj, xi, limits)
         boundaries = [Boundary(label, values[:, :, k], limit, at_least)
                       for k, (label, limit, at_least) in enumerate(limits)]
     return TradeoffSurfaces(spec, grids[0], grids[1], boundaries, dict(marks or {}))
