@@ -7,6 +7,13 @@ the required speed, on each track's stability family; optionally ζ_j ≥ ζ_min
 ``df/dx = df/dp · dp/dx`` (model Jacobian, then the parameter map of the setup); the stability rows from
 the eigenvalue sensitivities (:func:`railopt.models.stability.root_constraints`).  The objective and the
 response constraints at one x share one system and one eigen-decomposition.
+
+A ride objective (:class:`RMSTarget`) is the RMS of one output per metre of rail irregularity under a track
+spectrum at the family's speed over a band (:func:`railopt.models.random_response.random_response`, adaptive
+quadrature), a single function; its gradient is analytic on the final quadrature rule:
+``dRMS/dx = Σ_k w_k S_k Re(conj(H_k) dH_k/dx) / RMS`` with ``dH/dx = (iω)^q c·Z⁻¹(dF/dx − dZ/dx Z⁻¹F)`` from the
+member's tangent (the rule's nodes held fixed: the derivative of the discrete sum, equal to the derivative of
+the RMS to the quadrature tolerance).
 """
 
 from __future__ import annotations
@@ -18,11 +25,12 @@ import numpy as np
 
 from railopt.design import DesignVariable, MinimaxProblem
 from railopt.models import LinearSystem
+from railopt.models.random_response import random_response
 from railopt.models.sensitivity import maxima_jacobians
 from railopt.models.stability import damping_constraints, root_constraints
 from railopt.studies.catalog import ModelSetup
 
-__all__ = ["ResponseTarget", "StabilityTarget", "minimax_problem"]
+__all__ = ["RMSTarget", "ResponseTarget", "StabilityTarget", "minimax_problem", "rms_gradient"]
 
 
 @dataclass(frozen=True)
@@ -32,6 +40,63 @@ class ResponseTarget:
     output: str
     band: tuple[float, float]
     exact: bool = True
+
+
+@dataclass(frozen=True)
+class RMSTarget:
+    """RMS of ``output`` per metre of irregularity under ``spectrum`` (``.psd(Ω)`` m²/(rad/m)) at ``speed`` (m/s,
+    the family's own speed) over ``band_hz`` (Hz): ``scale × rms(family.at(p), spectrum, speed, band_hz)``.
+
+    ``scale`` makes it per metre: ``1/a`` for a model forced by an irregularity of amplitude a (m), whose
+    responses are per a (the response is linear in a).  ``rtol``: the quadrature's relative tolerance on the
+    variance."""
+
+    output: str
+    band_hz: tuple[float, float]
+    spectrum: object
+    speed: float
+    scale: float = 1.0
+    rtol: float = 1e-8
+
+
+def rms_gradient(system: LinearSystem, response, dp: np.ndarray) -> np.ndarray:
+    """d RMS / dx (d,) of a :class:`~railopt.models.random_response.RandomResponse` of ``system`` (a family member
+    with its tangent) on the response's own quadrature rule, for ``dp = dp/dx`` (P, d).
+
+    ``RMS² = Σ_k w_k S_k |H_k|²`` so ``dRMS = Σ_k w_k S_k Re(conj(H_k) dH_k) / RMS``, with
+    ``dH = (iω)^q c·Z⁻¹(dF − dZ X)``, ``X = Z⁻¹F``, ``dZ = dK − ω²dM + iω dC`` folded over the design variables
+    first (d small).  Outputs with a feedthrough are not supported (``ValueError``)."""
+    out = system.outputs[response.output]
+    if out.feedthrough is not None:
+        raise ValueError(f"output: {response.output!r} has a feedthrough; the analytic RMS gradient does not cover it")
+    t = system.tangent
+    if t is None:
+        raise ValueError("system: carries no parameter derivatives; build it with ParametricSystem.at(p)")
+    d = dp.shape[1]
+    if response.rms == 0.0:
+        return np.zeros(d)
+    w = response.rule.omega
+    q = {"displacement": 0, "velocity": 1, "acceleration": 2}[out.quantity]
+    F = system.forcing.values(w)  # (N, n)
+    Z = system.K[None] - w[:, None, None] ** 2 * system.M[None] + 1j * w[:, None, None] * system.C[None]
+    X = np.linalg.solve(Z, F[..., None])[..., 0]
+    adj = np.linalg.solve(np.swapaxes(Z, 1, 2), np.broadcast_to(out.row.astype(complex), F.shape)[..., None])[..., 0]
+    gain = (1j * w) ** q
+    H = gain * np.sum(adj * F, axis=1)
+    weight = response.rule.weights * response.input_psd
+    moving = np.flatnonzero(np.any(dp != 0.0, axis=1))
+    grad = np.zeros(d)
+    for j in range(d):
+        c = dp[moving, j]
+        dM, dC, dK = (np.tensordot(c, a[moving], axes=1) for a in (t.dM, t.dC, t.dK))
+        dZX = X @ dK.T - (w**2)[:, None] * (X @ dM.T) + 1j * w[:, None] * (X @ dC.T)
+        dF = np.zeros_like(F)
+        for i, ci in zip(moving, c, strict=True):
+            if t.dF[i] is not None and ci != 0.0:
+                dF += ci * t.dF[i].values(w)
+        dH = gain * np.sum(adj * (dF - dZX), axis=1)
+        grad[j] = float(np.dot(weight, (np.conj(H) * dH).real)) / response.rms
+    return grad
 
 
 @dataclass(frozen=True)
@@ -78,6 +143,17 @@ class _Evaluator:
             jacs.append(J @ dp)
         return np.concatenate(values), np.vstack(jacs)
 
+    def rms(self, x: np.ndarray, target: RMSTarget) -> tuple[np.ndarray, np.ndarray]:
+        """The ride objective at x (1,) and its gradient (1, d)."""
+        sys, dp = self.system(x)
+        r = random_response(sys, target.spectrum, target.speed, target.band_hz, target.output, target.rtol)
+        return np.array([target.scale * r.rms]), target.scale * rms_gradient(sys, r, dp)[None, :]
+
+    def objective(self, x: np.ndarray, target: ResponseTarget | RMSTarget) -> tuple[np.ndarray, np.ndarray]:
+        if isinstance(target, RMSTarget):
+            return self.rms(x, target)
+        return self.maxima(x, [target])
+
     def stability(self, x: np.ndarray, target: StabilityTarget) -> tuple[np.ndarray, np.ndarray]:
         """The rows of ``target`` at x and their Jacobian in x."""
         _, dp = self.system(x)
@@ -112,20 +188,26 @@ class _Evaluator:
 def minimax_problem(
     setup: ModelSetup,
     variables: Sequence[DesignVariable],
-    objective: ResponseTarget,
+    objective: ResponseTarget | RMSTarget,
     constraints: Sequence[ResponseTarget] = (),
     limits: Sequence[float] = (),
     stability: StabilityTarget | None = None,
 ) -> MinimaxProblem:
     """min_x max_k f_k(x) of ``objective`` subject to the f_k of each constraint ≤ its limit and, with
-    ``stability``, the stability rows ≤ 0."""
+    ``stability``, the stability rows ≤ 0.  A :class:`RMSTarget` objective is one function (the RMS per metre)."""
     names = [v.name for v in variables]
     unknown = [n for n in names if n not in setup.designable]
     if unknown:
         raise ValueError(f"variables: {unknown} are not parameters of the model; choose from {list(setup.designable)}")
     evaluator = _Evaluator(setup, names)
+    if isinstance(objective, RMSTarget):
+        if setup.family.speed is None or abs(objective.speed - setup.family.speed) > 1e-12 * setup.family.speed:
+            raise ValueError(f"objective.speed: {objective.speed} m/s is not the model's speed {setup.family.speed}")
+        if objective.output not in setup.family.output_names:
+            raise ValueError(f"objective.output: unknown output {objective.output!r}; outputs are "
+                             f"{list(setup.family.output_names)}")
     if not constraints and stability is None:
-        return MinimaxProblem(list(variables), lambda x: evaluator.maxima(x, [objective]), jacobian=True)
+        return MinimaxProblem(list(variables), lambda x: evaluator.objective(x, objective), jacobian=True)
     if stability is not None:
         missing = [t for t in stability.tracks if t not in setup.stability]
         if missing:
@@ -137,7 +219,7 @@ def minimax_problem(
     targets = list(constraints)
     return MinimaxProblem(
         list(variables),
-        lambda x: evaluator.maxima(x, [objective]),
+        lambda x: evaluator.objective(x, objective),
         jacobian=True,
         constraints=lambda x: evaluator.constraints(x, targets, stability),
         constraint_jacobian=True,

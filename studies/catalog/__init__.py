@@ -218,6 +218,9 @@ class ModelSetup:
     input_label : str
         The input the outputs are per (``"6.35 mm (0.25 in) lateral irregularity"``); empty when unforced or
         per unit force.
+    input_amplitude_m : float or None
+        The rail irregularity amplitude (m) the forcing is per (the outputs scale with it); None when the model
+        is not forced by a rail irregularity at its own speed.  A ride objective divides by it (per metre).
     """
 
     family: ParametricSystem
@@ -230,6 +233,7 @@ class ModelSetup:
     limits: dict[str, float] = field(default_factory=dict)
     units: dict[str, str] = field(default_factory=dict)
     input_label: str = ""
+    input_amplitude_m: float | None = None
 
     def axis_label(self, output: str, inch: bool = False) -> str:
         """An axis label naming the output, its unit and the input it is per:

@@ -213,4 +213,5 @@ def vehicle_forced_setup(options: VehicleForcedOptions) -> ModelSetup:
                           abscissa=model.family(names))
     setup.units = {r.name: r.unit + UNIT_SUFFIX[options.quantity] for r in output_rows(model, options.outputs)}
     setup.input_label = f"{options.input.amplitude_m * 1000:.4g} mm {options.input.kind} irregularity"
+    setup.input_amplitude_m = options.input.amplitude_m
     return setup

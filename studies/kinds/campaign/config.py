@@ -11,7 +11,7 @@ from pydantic import Field, field_validator, model_validator
 
 from railopt.design import DesignVariable
 from railopt.models.units import RAD_PER_HZ
-from railopt.studies.adapter import ResponseTarget, StabilityTarget
+from railopt.studies.adapter import ResponseTarget, RMSTarget, StabilityTarget
 from railopt.studies.catalog import ModelSetup, ModelsStudy, PositiveInterval, require_unique
 from railopt.studies.config import BandHz, FiniteModel, MethodName, StrictModel
 
@@ -20,9 +20,11 @@ __all__ = [
     "CampaignSettings",
     "CampaignStudyConfig",
     "ConstraintSpec",
+    "ObjectiveSpec",
     "OutputSpec",
     "ReportSpec",
     "SolverOptions",
+    "SpectrumSpec",
     "StabilitySpec",
     "SurfaceSpec",
     "TradeoffSpec",
@@ -74,6 +76,56 @@ class OutputSpec(FiniteModel):
     def target(self, setup: ModelSetup, exact: bool) -> ResponseTarget:
         output = self.output or setup.family.output_names[0]
         return ResponseTarget(output, (self.band_hz[0] * RAD_PER_HZ, self.band_hz[1] * RAD_PER_HZ), exact)
+
+
+class SpectrumSpec(StrictModel):
+    """``[objective.spectrum]``: the track spectrum of the ``rms`` objective
+    (:func:`railopt.models.track.spectra.irregularity_spectrum`): ``standard = "fra"`` with ``track_class`` 1–6,
+    ``"erri_b176"`` with ``level`` low/high, or ``"table"`` with ``path`` (CSV: wavenumber rad/m, PSD m²/(rad/m);
+    relative to the working directory); ``component`` profile/alignment (FRA also cross_level)."""
+
+    standard: Literal["fra", "erri_b176", "table"]
+    track_class: int | None = Field(None, strict=True)
+    level: Literal["low", "high"] | None = None
+    component: str = "profile"
+    path: str | None = None
+    rtol: float = Field(1e-8, gt=0, lt=0.1, description="relative tolerance of the RMS quadrature (variance)")
+
+    @model_validator(mode="after")
+    def _build(self) -> SpectrumSpec:
+        self.spectrum()  # its errors name the argument: track_class, level, component, path
+        return self
+
+    def spectrum(self):
+        from railopt.models.track.spectra import irregularity_spectrum
+
+        if self.standard == "table":
+            if self.path is None:
+                raise ValueError("path: a table spectrum needs the path of its CSV (wavenumber rad/m, PSD m²/(rad/m))")
+            bad = [n for n in ("track_class", "level") if getattr(self, n) is not None]
+            if bad:
+                raise ValueError(f"{bad[0]}: does not apply to a table spectrum")
+            try:
+                return irregularity_spectrum.from_table(self.path)
+            except OSError as exc:
+                raise ValueError(f"path: {exc}") from None
+        if self.path is not None:
+            raise ValueError(f"path: applies to standard = 'table' only, not {self.standard!r}")
+        return irregularity_spectrum(self.standard, track_class=self.track_class, level=self.level,
+                                     component=self.component)
+
+
+class ObjectiveSpec(OutputSpec):
+    """``[objective]``: an output over a band (Hz); with the ``rms`` objective also ``[objective.spectrum]``."""
+
+    spectrum: SpectrumSpec | None = None
+
+    def rms_target(self, setup: ModelSetup) -> RMSTarget:
+        """The ride objective: RMS of the output per metre of irregularity (responses divided by the model's
+        irregularity amplitude) under the spectrum at the model's speed over ``band_hz``."""
+        output = self.output or setup.family.output_names[0]
+        return RMSTarget(output, tuple(self.band_hz), self.spectrum.spectrum(), float(setup.family.speed),
+                         1.0 / setup.input_amplitude_m, self.spectrum.rtol)
 
 
 class ConstraintSpec(OutputSpec):
@@ -130,13 +182,16 @@ class CampaignDesign(CampaignSettings):
 
     variables: list[VariableSpec] = Field(min_length=1)
     methods: list[MethodName] = Field(default=["slsqp"], min_length=1)
-    objectives: list[Literal["thesis", "exact"]] = Field(default=["exact"], min_length=1)
+    objectives: list[Literal["thesis", "exact", "rms"]] = Field(
+        default=["exact"], min_length=1,
+        description="thesis: maxima (4.71)-(4.73); exact: certified band maximum; rms: RMS per metre under "
+                    "[objective.spectrum] at the model's speed")
     problems: list[Literal["constrained", "unconstrained"]] = Field(
         default=["constrained"], min_length=1,
         description="constrained: subject to [[constraints]] and [stability]; unconstrained: the objective alone")
     constrained_methods: list[MethodName] | None = Field(
         None, description="methods of the constrained problem when both problems run (default: methods)")
-    constrained_objectives: list[Literal["thesis", "exact"]] | None = Field(
+    constrained_objectives: list[Literal["thesis", "exact", "rms"]] | None = Field(
         None, description="objectives of the constrained problem when both problems run (default: objectives)")
 
     def plan(self, problem: str) -> list[tuple[str, str]]:
@@ -208,7 +263,7 @@ class SurfaceSpec(FiniteModel):
 
 class CampaignStudyConfig(ModelsStudy):
     KIND: ClassVar[str] = "campaign"
-    objective: OutputSpec
+    objective: ObjectiveSpec
     constraints: list[ConstraintSpec] = Field(default_factory=list)
     stability: StabilitySpec | None = None
     design: CampaignDesign
@@ -241,6 +296,7 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
     for field, spec in specs:
         if spec.output is not None and spec.output not in outputs:
             raise ValueError(f"{field}.output: unknown output {spec.output!r} of {where}; outputs are {list(outputs)}")
+    _check_rms(cfg, setup, where)
     before = [cfg.report.before] if cfg.report.before else []
     for field, named in (("design.start_from", cfg.design.start_from), ("report.compare", cfg.report.compare),
                          ("report.before", before)):
@@ -295,3 +351,27 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
             if not (v.lower <= x <= v.upper):
                 raise ValueError(f"design.start_from: named design {name!r}: {v.name} = {x:g} is outside its bounds")
         setup.parameters(names, np.array(point))
+
+
+def _check_rms(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:
+    """The ``rms`` objective needs a spectrum, a model with a forward speed forced per rail irregularity
+    (vehicle_forced: ``options.speed_m_s``, ``options.input.amplitude_m``), and a band inside the spectrum's
+    validity at that speed."""
+    wanted = set(cfg.design.objectives) | set(cfg.design.constrained_objectives or [])
+    if "rms" not in wanted:
+        return
+    if cfg.objective.spectrum is None:
+        raise ValueError("objective.spectrum: the rms objective needs a track spectrum ([objective.spectrum] with "
+                         "standard = 'fra' | 'erri_b176' | 'table')")
+    if setup.family.speed is None or setup.input_amplitude_m is None:
+        raise ValueError(f"design.objectives: 'rms' needs a model running at a forward speed over a rail "
+                         f"irregularity (vehicle_forced: options.speed_m_s); {where} has no speed "
+                         f"({setup.description})")
+    if not cfg.objective.band_hz[0] > 0:
+        raise ValueError(f"objective.band_hz: the rms objective needs a band above 0 Hz, got {cfg.objective.band_hz}")
+    from railopt.models.random_response import _check_spectrum_band
+
+    try:
+        _check_spectrum_band(cfg.objective.spectrum.spectrum(), setup.family.speed, tuple(cfg.objective.band_hz))
+    except ValueError as exc:
+        raise ValueError(f"objective.{exc} ({where})") from None

@@ -126,12 +126,13 @@ def campaign_label(model: str, objective: str, method: str, problem: str = "cons
 
 def campaign_problem(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str, problem: str = "constrained",
                      required_speed: float | None = None, limits: dict[int, float] | None = None) -> MinimaxProblem:
-    """The minimax problem of one model, objective kind ("thesis" or "exact") and problem: "constrained" (the
-    config's ``[[constraints]]`` and ``[stability]``) or "unconstrained" (the objective alone).  A sweep changes
-    the required speed of the stability rows (``required_speed``, m/s) or a constraint's limit (``limits``)."""
+    """The minimax problem of one model, objective kind ("thesis", "exact" or "rms": the RMS per metre under
+    ``[objective.spectrum]``) and problem: "constrained" (the config's ``[[constraints]]`` and ``[stability]``) or
+    "unconstrained" (the objective alone).  A sweep changes the required speed of the stability rows
+    (``required_speed``, m/s) or a constraint's limit (``limits``)."""
     exact = objective == "exact"
     variables = [v.variable() for v in cfg.design.variables]
-    target = cfg.objective.target(setup, exact)
+    target = cfg.objective.rms_target(setup) if objective == "rms" else cfg.objective.target(setup, exact)
     if problem == "unconstrained":
         return minimax_problem(setup, variables, target)
     constraints = [c.target(setup, c.exact) for c in cfg.constraints]
