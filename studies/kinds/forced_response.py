@@ -447,10 +447,5 @@ SECTIONS = [_models_section, _findings_section, _peaks_section, _modes_section, 
 """The summary, section by section."""
 
 
-KIND = register_kind(StudyKind(
-    name="forced_response",
-    config_model=ForcedResponseConfig,
-    compute=compute,
-    report=report,
-    summary="vehicle responses to sinusoidal rail irregularities, rigid vs flexible track (Figs 4.5–4.12)",
-))
+SUMMARY = "vehicle responses to sinusoidal rail irregularities, rigid vs flexible track (Figs 4.5–4.12)"
+KIND = register_kind(StudyKind("forced_response", ForcedResponseConfig, compute, report, summary=SUMMARY))

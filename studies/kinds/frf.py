@@ -150,10 +150,5 @@ def report(result: FRFResult, writer: Writer) -> str:
                       "![FRF](frf.png)", ""])
 
 
-KIND = register_kind(StudyKind(
-    name="frf",
-    config_model=FRFStudyConfig,
-    compute=compute,
-    report=report,
-    summary="frequency responses and certified band maxima of catalogued models at given designs",
-))
+SUMMARY = "frequency responses and certified band maxima of catalogued models at given designs"
+KIND = register_kind(StudyKind("frf", FRFStudyConfig, compute, report, summary=SUMMARY))

@@ -214,10 +214,5 @@ def _track_effect(cfg: SpeedSweepConfig, critical: pd.DataFrame) -> pd.DataFrame
     return pd.DataFrame(rows)
 
 
-KIND = register_kind(StudyKind(
-    name="speed_sweep",
-    config_model=SpeedSweepConfig,
-    compute=compute,
-    report=report,
-    summary="root locus, critical speed and sensitivities over forward speed",
-))
+SUMMARY = "root locus, critical speed and sensitivities over forward speed"
+KIND = register_kind(StudyKind("speed_sweep", SpeedSweepConfig, compute, report, summary=SUMMARY))

@@ -459,10 +459,5 @@ def _markdown(cfg: TrackStudyConfig, s: dict, maxima: list[dict], files: list[st
     return "\n".join(lines) + "\n"
 
 
-KIND = register_kind(StudyKind(
-    name="track",
-    config_model=TrackStudyConfig,
-    compute=compute,
-    report=report,
-    summary="Track beam on a Kelvin foundation: Figs 3.3–3.9, amplification, lumped track (thesis Ch. 3)",
-))
+SUMMARY = "Track beam on a Kelvin foundation: Figs 3.3–3.9, amplification, lumped track (thesis Ch. 3)"
+KIND = register_kind(StudyKind("track", TrackStudyConfig, compute, report, summary=SUMMARY))

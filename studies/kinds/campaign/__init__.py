@@ -22,11 +22,5 @@ from railopt.studies.kinds.campaign.run import campaign_problem, compute, design
 
 __all__ = ["KIND", "CampaignStudyConfig", "campaign_problem", "compute", "design_peak", "report"]
 
-KIND = register_kind(StudyKind(
-    name="campaign",
-    config_model=CampaignStudyConfig,
-    compute=compute,
-    report=report,
-    summary="multi-start minimax campaign (problems × methods × objectives) of a catalogued model",
-    warnings=warnings,
-))
+SUMMARY = "multi-start minimax campaign (problems × methods × objectives) of a catalogued model"
+KIND = register_kind(StudyKind("campaign", CampaignStudyConfig, compute, report, summary=SUMMARY, warnings=warnings))
