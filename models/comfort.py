@@ -63,9 +63,9 @@ from pathlib import Path
 
 import numpy as np
 
+from railopt.models.units import RAD_PER_HZ as TWO_PI
 from railopt.models.validation import number
 
-TWO_PI = 2.0 * math.pi
 BLOCK_S = 5.0  # EN 12299 RMS block length (s)
 PsdLike = Callable[[np.ndarray], np.ndarray] | None
 

@@ -52,9 +52,9 @@ import numpy as np
 import scipy.linalg as sla
 
 from railopt.models.system import LinearSystem
+from railopt.models.units import RAD_PER_HZ as TWO_PI
 from railopt.models.validation import number
 
-TWO_PI = 2.0 * math.pi
 _GL8 = np.polynomial.legendre.leggauss(8)
 _GL16 = np.polynomial.legendre.leggauss(16)
 PER_DECADE = 8  # initial panels per decade of the band

@@ -33,6 +33,7 @@ import pandas as pd
 
 from railopt.models.modal import NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots
 from railopt.models.peak_search import cell_maxima
+from railopt.models.units import rad_s_to_hz
 from railopt.models.validation import band as validate_band
 from railopt.models.validation import band_arg
 from railopt.records import ArrayRecord
@@ -137,7 +138,7 @@ class ResponseMaxima(ArrayRecord):
                 "function": self.labels,
                 "value": self.values,
                 "frequency_rad_s": self.frequencies,
-                "frequency_hz": self.frequencies / (2 * np.pi),
+                "frequency_hz": rad_s_to_hz(self.frequencies),
             }
         )
 

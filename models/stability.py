@@ -31,6 +31,7 @@ from railopt.models.sensitivity import (
     root_speed_derivative,
 )
 from railopt.models.system import LinearSystem
+from railopt.models.units import rad_s_to_hz
 from railopt.models.validation import number
 from railopt.records import ArrayRecord
 
@@ -122,7 +123,7 @@ class RootLocus(ArrayRecord):
             s = s[np.lexsort((s.real, s.imag))]
             for j, r in enumerate(s):
                 mag = abs(r)
-                rows.append((float(S), j, r.real, r.imag, -r.real / mag if mag > 0 else 1.0, r.imag / (2.0 * math.pi)))
+                rows.append((float(S), j, r.real, r.imag, -r.real / mag if mag > 0 else 1.0, rad_s_to_hz(r.imag)))
         return pd.DataFrame(rows, columns=["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz"])
 
 
@@ -289,7 +290,7 @@ def _critical_root(counted: _Counted, speed: float) -> tuple[float, str, str]:
     j = int(np.argmax(real))
     zeta = -m.s[j].real / abs(m.s[j])
     name, _, _ = mode_name(system.names, _shares(system, m.V[:n, j]), zeta, counted.groups, counted.main)
-    return (float(abs(m.s[j].imag)) / (2.0 * math.pi), name, system.names[int(np.argmax(np.abs(m.V[:n, j])))])
+    return (float(rad_s_to_hz(abs(m.s[j].imag))), name, system.names[int(np.argmax(np.abs(m.V[:n, j])))])
 
 
 def least_damping(model: object, speeds: Sequence[float], track: str | None = None) -> float:
@@ -407,7 +408,7 @@ def modes(model: LinearSystem | object, speed: float | None = None, track: str |
         else:
             name, group, share = mode_name(system.names, shares, zeta, groups, main)
         track_share = float(sum(v for c, v in zip(system.names, shares, strict=True) if _track_body(_body_dof(c)[0])))
-        rows.append({"frequency_hz": abs(s.imag) / (2 * math.pi), "damping_ratio": zeta, "real": s.real,
+        rows.append({"frequency_hz": rad_s_to_hz(abs(s.imag)), "damping_ratio": zeta, "real": s.real,
                      "imag": abs(s.imag), "name": name, "group": group, "share": share, "track_share": track_share})
     return pd.DataFrame(rows)
 

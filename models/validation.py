@@ -12,6 +12,8 @@ from numbers import Real
 
 import numpy as np
 
+from railopt.models.units import RAD_PER_HZ
+
 
 def number(name: str, value: object, *, positive: bool = False, non_negative: bool = False) -> float:
     """A finite real number (Python or numpy scalar, not bool), optionally > 0 or ≥ 0."""
@@ -117,7 +119,7 @@ def _in_rad_s(positional: object, in_hz: object, in_rad_s: object, names: tuple[
     if (in_hz is None) == (in_rad_s is None):
         raise ValueError(f"{hz_name}: give exactly one of {hz_name}= in Hz or {rad_name}= in rad/s")
     if in_hz is not None:
-        return 2.0 * math.pi * np.asarray(check(in_hz, hz_name, "Hz"))
+        return RAD_PER_HZ * np.asarray(check(in_hz, hz_name, "Hz"))
     return check(in_rad_s, rad_name, "rad/s")
 
 

@@ -30,6 +30,8 @@ import numpy as np
 from scipy.special import ellipe, ellipk, gammaln
 
 from railopt.models.contact import kalker_table
+from railopt.models.units import INCH as _INCH
+from railopt.models.units import POUND_FORCE as _LBF
 from railopt.models.validation import number as finite
 from railopt.models.validation import poisson, positive
 
@@ -38,8 +40,6 @@ THEORIES: tuple[str, ...] = ("vermeulen-johnson", "kalker", "carter")
 
 #: Carter's constant of (4.10) in its own units, lbf^½ / in^½ (f in lbf for r0 in in and N in lbf).
 CARTER_CONSTANT_US = 3500.0
-_LBF = 4.4482216152605  # N
-_INCH = 0.0254  # m
 #: The same constant in SI, N^½ / m^½ (f in N for r0 in m and N in N): 3500 √(lbf/in) ≈ 4.632e4.
 CARTER_CONSTANT_SI = CARTER_CONSTANT_US * math.sqrt(_LBF / _INCH)
 

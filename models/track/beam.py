@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from railopt.models.units import rad_s_to_hz
 from railopt.models.validation import number as _check_finite
 
 
@@ -88,7 +89,7 @@ class Beam:
     @property
     def f0(self) -> float:
         """Natural frequency ``sqrt(k/m) / 2π``, Hz (4.35)."""
-        return self.omega0 / (2.0 * math.pi)
+        return rad_s_to_hz(self.omega0)
 
     @property
     def critical_damping(self) -> float:

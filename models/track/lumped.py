@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass
 import pandas as pd
 
 from railopt.models.track.beam import Beam
+from railopt.models.units import rad_s_to_hz
 from railopt.records import ArrayRecord
 
 
@@ -104,7 +105,7 @@ def lumped(beam: Beam, damping_ratio: float, contact_spacing: float = 1.5) -> Lu
     half = 0.5 * contact_spacing**2
     return LumpedTrack(
         l_e=l_e,
-        f0=math.sqrt(K_e / m_e) / (2.0 * math.pi),
+        f0=rad_s_to_hz(math.sqrt(K_e / m_e)),
         K_e=K_e,
         m_e=m_e,
         C_e=C_e,

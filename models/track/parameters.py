@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from railopt.models.track.beam import Beam
-from railopt.models.units import INCH, LB_PER_YARD, POUND_MASS, PSI
+from railopt.models.units import INCH, LB_PER_YARD, POUND_MASS, PSI, hz_to_rad_s, rad_s_to_hz
 
 E_STEEL = 30.0e6 * PSI  # Pa
 TRACK_MODULUS = 3000.0 * PSI  # N/m² per rail
@@ -57,7 +57,7 @@ def tie_mass_per_rail() -> float:
 
 def mass_for_frequency(k: float, f0: float = THESIS_F0) -> float:
     """Effective mass per length giving ``f0 = sqrt(k/m)/2π`` (4.35), kg/m."""
-    return k / (2.0 * math.pi * f0) ** 2
+    return k / hz_to_rad_s(f0) ** 2
 
 
 def wooden_tie_track(rail: RailSection = RAIL_132RE, k: float = TRACK_MODULUS, f0: float = THESIS_F0) -> Beam:
@@ -82,7 +82,7 @@ def f0_table(rail: RailSection = RAIL_132RE) -> pd.DataFrame:
                     "k_N_m2": k,
                     "mass": label,
                     "m_kg_m": m,
-                    "f0_Hz": math.sqrt(k / m) / (2.0 * math.pi),
+                    "f0_Hz": rad_s_to_hz(math.sqrt(k / m)),
                 }
             )
     return pd.DataFrame(rows)

@@ -49,9 +49,9 @@ from pathlib import Path
 
 import numpy as np
 
+from railopt.models.units import RAD_PER_HZ as TWO_PI
 from railopt.models.validation import number, real_array
 
-TWO_PI = 2.0 * math.pi
 CM2_TO_M2 = 1e-4
 FRA_K = 0.25
 

@@ -30,11 +30,10 @@ import numpy as np
 
 from railopt.models.forcing import Forcing
 from railopt.models.parametric import ParameterPart, ParametricSystem
+from railopt.models.units import INCH, MPH, hz_to_rad_s
 from railopt.models.validation import number
 from railopt.models.vehicle.geometry import point_jacobian
 
-INCH = 0.0254  # m
-MPH = 0.44704  # m/s
 LATERAL = ("v", "alpha", "gamma")
 
 
@@ -61,7 +60,7 @@ class CabInput:
 
     @property
     def band_rad_s(self) -> tuple[float, float]:
-        return 0.0, 2 * math.pi * self.max_frequency_hz
+        return 0.0, hz_to_rad_s(self.max_frequency_hz)
 
 
 def _index(coordinates: Sequence[str], name: str) -> int:

@@ -32,6 +32,7 @@ import pandas as pd
 from railopt.models.forcing import DistanceForcing, Forcing
 from railopt.models.modal import growing_roots
 from railopt.models.system import RESPONSE_ORDER, LinearSystem
+from railopt.models.units import hz_to_rad_s
 from railopt.models.validation import frequencies_rad_s
 from railopt.models.vehicle.irregularity import Irregularity, RailInput, wavelength_m
 from railopt.models.vehicle.outputs import UNIT_SUFFIX, PointOutput, output_rows
@@ -134,7 +135,7 @@ def _frequencies(frequencies_hz) -> np.ndarray:
 def _solve(system: LinearSystem, f: np.ndarray, names: list[str]) -> tuple[np.ndarray, np.ndarray, bool]:
     """Output values (N, outputs), the relative residuals ‖Z X − F‖∞ / ‖F‖∞ (N,) by direct solves, and whether a
     steady state exists (no root with Re s > 0)."""
-    w = 2 * np.pi * f
+    w = hz_to_rad_s(f)
     with np.errstate(over="ignore", invalid="ignore"):
         Z = system.K[None] - w[:, None, None] ** 2 * system.M[None] + 1j * w[:, None, None] * system.C[None]
     if not np.all(np.isfinite(Z)):

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from railopt.models.units import GRAVITY
+from railopt.models.units import GRAVITY, rad_s_to_hz
 from railopt.models.vehicle.elements import GROUND
 from railopt.models.vehicle.vehicle import Vehicle
 
@@ -250,7 +250,7 @@ def body_frequencies(v: Vehicle, speed: float = NOMINAL_SPEED) -> dict[tuple[str
             share = M[j, j] * np.abs(X[j, :]) ** 2 / np.where(total > 0, total, np.inf)
             best = np.flatnonzero(share >= share.max() - 1e-9)
             k = best[np.argmin(np.abs(m.s[best]))]
-            out[(name, kind)] = float(abs(m.s[k])) / (2.0 * math.pi)
+            out[(name, kind)] = float(rad_s_to_hz(abs(m.s[k])))
     return out
 
 

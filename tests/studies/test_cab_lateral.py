@@ -137,7 +137,7 @@ def test_pareto_rows_are_dominated_by_nothing_computed(flagship):
 def test_critical_speed_pareto_rows_are_dominated_by_nothing_computed(flagship):
     """The same promise for U against the critical speed (maximised): recomputed with the model layer."""
     from railopt.models.stability import critical_speed
-    from railopt.models.vehicle.cab import MPH
+    from railopt.models.units import MPH
 
     _, out = flagship
     names = NAMES
