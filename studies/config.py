@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import re
-import tomllib
 import types
 import typing
 from pathlib import Path
@@ -23,6 +22,7 @@ from typing import Annotated, Any
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator
 
 from railopt.studies.kind import StudyKind, discover_kinds
+from railopt.tomlfile import read_toml as _read_toml
 
 __all__ = [
     "INT64_MAX",
@@ -210,51 +210,15 @@ def study_kind(name: str) -> StudyKind:
     return kinds[name]
 
 
-_HEADER = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?")
-_KEY = re.compile(r"([A-Za-z0-9_\-]+)\s*=\s*")
-
-
-def _long_integer_key(text: str) -> str | None:
-    """``"table.key"`` (or ``"line N"``) of the first integer literal over Python's int-string digit limit."""
-    table = ""
-    for n, line in enumerate(text.splitlines(), start=1):
-        header = _HEADER.match(line)
-        if header and "=" not in line.split("]")[0]:
-            table = header.group(1).strip().replace('"', "")
-            continue
-        digits = re.search(r"(?<![\w.])[+-]?[0-9][0-9_]{4300,}", line)
-        if digits:
-            keys = [m.group(1) for m in _KEY.finditer(line[:digits.start()])]
-            if not keys:
-                return f"line {n}"
-            return ".".join([table] * bool(table) + keys[:1] + keys[1:][-1:])
-    return None
 
 
 def read_toml(path: str | Path, what: str = "study") -> dict[str, Any]:
-    """The parsed TOML of ``path``; every failure is a :class:`ConfigError` ``"<file>: <what is wrong>"``."""
-    path = Path(path)
+    """The parsed TOML of ``path``; every failure is a :class:`ConfigError` ``"<file>: <what is wrong>"``
+    (:func:`railopt.tomlfile.read_toml`)."""
     try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot read the {what} file ({exc.strerror})") from None
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"{path}: not a text file (byte {exc.start} is not UTF-8); a {what} is a TOML file") \
-            from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
-    except RecursionError:
-        raise ConfigError(f"{path}: not valid TOML (nested too deeply)") from None
-    except ValueError as exc:  # an integer over Python's int-string limit (4300 digits): not a TOMLDecodeError
-        key = _long_integer_key(text)
-        where = f"{key}: " if key else ""
-        limit = "the int-string limit" if "limit" not in str(exc) else str(exc).split(":")[0].strip()
-        raise ConfigError(f"{path}: {where}integer too long to read ({limit}); no field takes a number that large") \
-            from None
+        return _read_toml(path, what)
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
 
 
 PATH_OPTIONS: tuple[str, ...] = ("vehicle",)

@@ -14,7 +14,6 @@ from __future__ import annotations
 import ast
 import math
 import operator
-import tomllib
 from collections.abc import Mapping
 from importlib import resources
 from pathlib import Path
@@ -39,6 +38,7 @@ from railopt.models.vehicle.schema import (
 from railopt.models.vehicle.spec import ConstraintSpec, ContactSpec, Lengths, TrackSpec
 from railopt.models.vehicle.vehicle import Vehicle
 from railopt.models.vehicle.wheelrail import Creep
+from railopt.tomlfile import read_toml
 
 BUNDLED = ("sd40-2", "single-wheelset", "manchester-coach")
 MAX_DEPTH = 32  # nesting of an arithmetic expression
@@ -129,18 +129,9 @@ def read_vehicle_file(name_or_path: str | Path) -> tuple[dict[str, Any], str]:
         if not path.is_file():
             raise VehicleFileError(f"{name_or_path}: no such vehicle file; bundled vehicles: {', '.join(BUNDLED)}")
     try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise VehicleFileError(f"{path}: cannot read vehicle file ({exc.strerror or exc})") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise VehicleFileError(f"{path}: not a text file (byte {exc.start} is not UTF-8); a vehicle file is TOML") \
-            from None
-    try:
-        return tomllib.loads(text), str(path)
-    except (tomllib.TOMLDecodeError, ValueError, RecursionError) as exc:
-        raise VehicleFileError(f"{path}: cannot read vehicle file ({exc})") from None
+        return read_toml(path, "vehicle file"), str(path)
+    except ValueError as exc:
+        raise VehicleFileError(str(exc)) from None
 
 
 def load_vehicle(name_or_path: str | Path, lengths: Mapping[str, float] | None = None) -> Vehicle:

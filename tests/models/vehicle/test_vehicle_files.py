@@ -106,7 +106,7 @@ def test_missing_body_table_and_constraint_body(tmp_path: Path) -> None:
 def test_unknown_name_and_bad_toml(tmp_path: Path) -> None:
     with pytest.raises(VehicleFileError, match="no-such-loco.*bundled vehicles: sd40-2"):
         load_vehicle("no-such-loco")
-    with pytest.raises(VehicleFileError, match="cannot read"):
+    with pytest.raises(VehicleFileError, match="vehicle.toml: not valid TOML"):
         load_vehicle(write(tmp_path, "[vehicle\nname="))
 
 
