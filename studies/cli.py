@@ -107,6 +107,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             scheduler=args.scheduler,
             scheduler_timeout=args.scheduler_timeout,
             resume=args.resume,
+            retry_failed=args.retry_failed,
             show_progress=not args.no_progress,
         )
         try:
@@ -222,6 +223,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help=f"how long to wait for the scheduler (also ${SCHEDULER_TIMEOUT_ENV}; default 5)")
     stores = run.add_mutually_exclusive_group()
     stores.add_argument("--resume", action="store_true", help="finish an interrupted campaign from its store")
+    run.add_argument("--retry-failed", action="store_true",
+                     help="with --resume: run again the starts stored as worker_lost (a start that killed its worker)")
     stores.add_argument("--fresh", action="store_true",
                         help="start new campaign stores; the old ones are discarded when this run is published")
     run.add_argument("--results", default="results", help="results root folder (default: ./results)")

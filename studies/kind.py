@@ -38,6 +38,7 @@ class StudyContext:
     scheduler: str | None = None
     scheduler_timeout: float | None = None  # s; None: $RAILOPT_SCHEDULER_TIMEOUT or the default
     resume: bool = False
+    retry_failed: bool = False  # --resume also re-runs the starts stored as worker_lost
     show_progress: bool = True
 
 

@@ -84,7 +84,8 @@ def run_campaign(
     try:
         return multistart(problem, settings.n_starts, method=settings.method, seed=settings.seed,
                           sampler=settings.sampler, points=points, client=client, store=store,
-                          options=settings.solver_options(), progress=bar.update)
+                          options=settings.solver_options(), progress=bar.update,
+                          retry_failed=context.retry_failed)
     finally:
         bar.close()
         store.close()
