@@ -8,7 +8,9 @@ Public names:
 * :func:`impulse_response_at_load` — (3.20)–(3.24), closed form or numerical inversion;
 * :func:`transient` → :class:`TransientSolution` — load cases (i)–(vi) of §3.2.2;
 * :func:`lumped` → :class:`LumpedTrack` — (4.33)–(4.39) and the roll terms of (4.49);
-* :func:`dynamic_amplification` — maximum and lag over v/v_cr, c/c_cr, N/N_cr.
+* :func:`dynamic_amplification` — maximum and lag over v/v_cr, c/c_cr, N/N_cr;
+* :func:`irregularity_spectrum` → :class:`RationalSpectrum` (FRA classes 1–6, ERRI B176) or, with
+  ``.from_table(path)``, :class:`TabulatedSpectrum` — random track geometry (:mod:`.spectra`, docs/ride.md).
 """
 
 from railopt.models.track.amplification import dynamic_amplification
@@ -25,6 +27,7 @@ from railopt.models.track.moving_load import (
     static_deflection,
 )
 from railopt.models.track.parameters import RAIL_115RE, RAIL_132RE, RailSection, f0_table, wooden_tie_track
+from railopt.models.track.spectra import RationalSpectrum, TabulatedSpectrum, irregularity_spectrum
 from railopt.models.track.transient import (
     DistributedImpulse,
     ImpulseLoad,
@@ -45,7 +48,9 @@ __all__ = [
     "RAIL_115RE",
     "RAIL_132RE",
     "RailSection",
+    "RationalSpectrum",
     "SuddenLoad",
+    "TabulatedSpectrum",
     "TransientSolution",
     "characteristic_roots",
     "closed_form_solution",
@@ -55,6 +60,7 @@ __all__ = [
     "hetenyi_deflection",
     "impulse_constant",
     "impulse_response_at_load",
+    "irregularity_spectrum",
     "lumped",
     "moving_load",
     "printed_impulse_constant",
