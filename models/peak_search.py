@@ -102,7 +102,7 @@ def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower
 
     Newton steps on the local parabola: each step samples x ± h (one call of ``fun`` for every bracket) and moves
     to the vertex of the parabola through the three points of φ = 1/f² (``positive``; exactly a parabola near a
-    resonance of one pole, see :func:`cell_maxima`) or of −f, with h the length of the last step (at least
+    resonance of one pole, see :func:`cell_maxima`) or of −f, with h a tenth of the last step (at least
     10·tol), so the steps contract superlinearly; a start within a quarter of the bracket from its ends starts
     mid-way instead.  A bracket is done when a step is below tol (Brent's ``rtol``·width/3, as in
     :func:`bracketed_maximum`) from a parabola fitted over at most 100·tol.  Returns ``(x, ok)``; ``ok`` is False
@@ -140,7 +140,7 @@ def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower
         ok[live[done]] = True
         x[live[good]] = new[good]
         keep = good & ~done
-        live, h = live[keep], np.maximum(np.abs(step[keep]), 10.0 * tol[live[keep]])
+        live, h = live[keep], np.maximum(0.1 * np.abs(step[keep]), 10.0 * tol[live[keep]])
     return x, ok
 
 
