@@ -213,3 +213,48 @@ def test_ride_study_runs_end_to_end_and_reproduces_the_committed_rms(tmp_path):
     assert list(fresh["design"]) == list(committed["design"])
     np.testing.assert_allclose(fresh["rms"], committed["rms"], rtol=1e-6)
     assert (tmp_path / "ride_comfort" / "psd.png").is_file()
+
+
+@pytest.mark.slow
+def test_a_campaign_with_the_rms_objective_finds_the_ride_studys_rms_optimum(tmp_path):
+    """The campaign kind's "rms" objective and the ride kind's RMS-random criterion are the same function: the
+    campaign's best RMS equals the ride study's rms_random row of the coach (same model, band, spectrum)."""
+    from railopt.studies.cli import main
+
+    study = tomllib.loads(STUDY.read_text())
+    coach = next(c for c in study["cases"] if c["model"] == "coach")
+    options = next(m for m in study["models"] if m["label"] == "coach")["options"]
+    variables = "\n".join(f'[[design.variables]]\nname = "{v["name"]}"\nlower = {v["lower"]}\nupper = {v["upper"]}\n'
+                          f'scale = "{v["scale"]}"\n' for v in coach["variables"])
+    spec = coach["spectrum"]
+    text = f"""
+[study]
+name = "rms_campaign"
+kind = "campaign"
+
+[[models]]
+label = "coach"
+model = "vehicle_forced"
+options = {{ vehicle = "{options['vehicle']}", view = "vertical", speed_m_s = {options['speed_m_s']}, input = {{ kind = "vertical", amplitude_m = 0.02 }}, outputs = ["{SEAT}"], quantity = "acceleration" }}
+
+[objective]
+output = "{SEAT}"
+band_hz = {coach['band_hz']}
+[objective.spectrum]
+standard = "{spec['standard']}"
+level = "{spec['level']}"
+component = "{spec['component']}"
+
+[design]
+objectives = ["rms"]
+n_starts = 2
+start_from = ["existing"]
+
+{variables}
+"""  # noqa: E501
+    path = _write(tmp_path, text)
+    assert main(["run", str(path), "--workers", "0", "--results", str(tmp_path / "out"), "--no-progress"]) == 0
+    comparison = pd.read_csv(tmp_path / "out" / "rms_campaign" / "comparison.csv")
+    designs = pd.read_csv(RESULTS / "designs.csv")
+    ride = designs[(designs["case"] == coach["label"]) & (designs["design"] == "rms_random")]["rms"].iloc[0]
+    assert comparison["U_objective"].iloc[0] == pytest.approx(ride, rel=1e-6)
