@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import call, map_unordered
+from railopt.design.parallel import call, check_picklable, map_unordered
 from railopt.design.problem import MinimaxProblem
 from railopt.records import ArrayRecord
 
@@ -88,6 +88,8 @@ def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], nam
     if base.shape != (len(space_names),) or not np.all(np.isfinite(base)):
         raise ValueError(f"base: expected {len(space_names)} finite values")
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
+    if client is not None:
+        check_picklable(fn)  # named from fn's own fields (e.g. problem.functions), not the row task's
     rows = dict(map_unordered(call, [_Row(fn, base, i, j, xi, float(v)) for v in xj], client=client))
     return np.array([rows[float(v)] for v in xj])
 
