@@ -243,6 +243,14 @@ class TradeoffSpec(FiniteModel):
     n_starts: int = Field(4, ge=1, le=1000, strict=True)
     exact: bool = True
 
+    @field_validator("epsilons")
+    @classmethod
+    def _positive(cls, v: list[float]) -> list[float]:
+        bad = [e for e in v if not e > 0]
+        if bad:
+            raise ValueError(f"every target must be > 0 (an output limit, or a speed in m/s), got {bad}")
+        return v
+
     @model_validator(mode="after")
     def _one(self) -> TradeoffSpec:
         if (self.output is None) == (self.check is None):
@@ -351,6 +359,13 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
             if not (v.lower <= x <= v.upper):
                 raise ValueError(f"design.start_from: named design {name!r}: {v.name} = {x:g} is outside its bounds")
         setup.parameters(names, np.array(point))
+    # the objective must have a response over its band at the model's own design (e.g. not unbounded at 0 Hz)
+    if "rms" not in cfg.design.objectives or len(cfg.design.objectives) > 1:
+        output = cfg.objective.output or setup.family.output_names[0]
+        try:
+            setup.family.at().response_maxima(band_hz=cfg.objective.band_hz, exact=False, output=output)
+        except ValueError as exc:
+            raise ValueError(f"objective.band_hz: {where}: {exc}") from None
 
 
 def _check_rms(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:

@@ -506,7 +506,7 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
     objective = "exact" if "exact" in cfg.design.objectives else cfg.design.objectives[0]
     rows = comparison[(comparison["model"] == model) & (comparison["objective"] == objective)
                       & (comparison["problem"] == cfg.design.problems[0])]
-    rows = rows[np.isfinite(rows.get("true_peak", pd.Series(dtype=float)))]
+    rows = rows[np.isfinite(rows["true_peak"])] if "true_peak" in rows.columns else rows.iloc[0:0]
     if rows.empty and recommended is None:
         return ModelSections(model, tag, None, objective)
     best = rows.sort_values("true_peak").iloc[0] if len(rows) else None
