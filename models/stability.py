@@ -109,22 +109,30 @@ class RootLocus(ArrayRecord):
         Forward speeds, m/s.
     roots : (N, 2n) ndarray
         Roots at each speed (1/s), in railopt's mode order (ascending |Im s|, then Re s).
+    names : (N, 2n) ndarray of str, optional
+        The mode name of each root (:func:`mode_name`, from its eigenvector's kinetic-energy shares).
     """
 
     speeds: np.ndarray
     roots: np.ndarray
+    names: np.ndarray | None = None
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per root with Im s ≥ 0: ``speed`` (m/s), ``mode`` (rank by frequency at that speed), ``real``,
-        ``imag`` (1/s, rad/s), ``damping_ratio`` (−Re s/|s|), ``frequency_hz``."""
+        ``imag`` (1/s, rad/s), ``damping_ratio`` (−Re s/|s|), ``frequency_hz`` and, when the locus has them,
+        ``name`` (:func:`mode_name` of that root's eigenvector: "body hunting", "front bogie hunting", ...)."""
         rows = []
-        for S, s in zip(self.speeds, self.roots, strict=True):
-            s = s[s.imag >= 0.0]
-            s = s[np.lexsort((s.real, s.imag))]
-            for j, r in enumerate(s):
+        names = self.names if self.names is not None else np.full(self.roots.shape, "", dtype=object)
+        for S, s, label in zip(self.speeds, self.roots, names, strict=True):
+            up = s.imag >= 0.0
+            s, label = s[up], label[up]
+            order = np.lexsort((s.real, s.imag))
+            for j, (r, name) in enumerate(zip(s[order], label[order], strict=True)):
                 mag = abs(r)
-                rows.append((float(S), j, r.real, r.imag, -r.real / mag if mag > 0 else 1.0, rad_s_to_hz(r.imag)))
-        return pd.DataFrame(rows, columns=["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz"])
+                rows.append((float(S), j, r.real, r.imag, -r.real / mag if mag > 0 else 1.0, rad_s_to_hz(r.imag),
+                             name))
+        table = pd.DataFrame(rows, columns=["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz", "name"])
+        return table if self.names is not None else table.drop(columns="name")
 
 
 def root_locus(model: object, speeds: Sequence[float], track: str | None = None) -> RootLocus:
@@ -137,7 +145,14 @@ def root_locus(model: object, speeds: Sequence[float], track: str | None = None)
     """
     S = _speeds(speeds)
     counted = _Counted(model, track)
-    return RootLocus(S, np.array([counted.roots(float(v)) for v in S]))
+    roots, names = [], []
+    for v in S:
+        system = counted.at(float(v))
+        counted.solves += 1
+        order = mode_order(system.modal().s)
+        roots.append(system.modal().s[order])
+        names.append([row["name"] for row in _named_roots(system, order, counted.groups, counted.main)])
+    return RootLocus(S, np.array(roots), np.array(names, dtype=object))
 
 
 @dataclass(frozen=True)
@@ -394,11 +409,17 @@ def modes(model: LinearSystem | object, speed: float | None = None, track: str |
         groups = getattr(model, "groups", None)
     main = getattr(model, "main_body", None)
     system = model if isinstance(model, LinearSystem) else _speed_function(model, track)(speed)
+    return pd.DataFrame(_named_roots(system, mode_order(system.modal().s)[1::2], groups, main))
+
+
+def _named_roots(system: LinearSystem, indices: np.ndarray, groups: Mapping[str, str] | None,
+                 main: str | None) -> list[dict]:
+    """One row per root ``system.modal().s[k]`` (k in ``indices``) with its :func:`mode_name`."""
     m = system.modal()
     n = system.n
     scale = float(np.max(np.abs(m.s)))
     rows = []
-    for k in mode_order(m.s)[1::2]:
+    for k in indices:
         s = m.s[k]
         shares = _shares(system, m.V[:n, k])
         mag = abs(s)
@@ -410,7 +431,7 @@ def modes(model: LinearSystem | object, speed: float | None = None, track: str |
         track_share = float(sum(v for c, v in zip(system.names, shares, strict=True) if _track_body(_body_dof(c)[0])))
         rows.append({"frequency_hz": rad_s_to_hz(abs(s.imag)), "damping_ratio": zeta, "real": s.real,
                      "imag": abs(s.imag), "name": name, "group": group, "share": share, "track_share": track_share})
-    return pd.DataFrame(rows)
+    return rows
 
 
 # ---------------------------------------------------------------------------------------------- design constraints

@@ -249,9 +249,9 @@ def _locus_axes(ax_z, ax_f, max_hz: float, shown: pd.DataFrame) -> None:
 
 def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame, max_hz: float = 25.0) -> Figure:
     """Velocity root loci in the rail convention: per model, the damping ratio (top) and the frequency (bottom,
-    Hz) of each root against forward speed, sharing the speed axis; roots with ζ < 0 (hunting) in red, the
-    critical speed dashed.  Roots above ``max_hz`` (track modes) are not drawn; each model's panel and the
-    caption say how many.
+    Hz) of each root against forward speed, sharing the speed axis; roots with ζ < 0 (hunting) in red, named
+    in the legend when the locus has mode names, the critical speed dashed.  Roots above ``max_hz`` (track
+    modes) are not drawn; each model's panel and the caption say how many.
     """
     models = list(dict.fromkeys(locus["model"]))
     ncols = min(2, len(models))
@@ -265,7 +265,9 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame, max_hz: float =
         d = locus[locus["model"] == m]
         _locus_panels(ax_z, ax_f, d[d["damping_ratio"] >= 0], max_hz, "C0", "o", "roots, ζ ≥ 0")
         if (d["damping_ratio"] < 0).any():
-            _locus_panels(ax_z, ax_f, d[d["damping_ratio"] < 0], max_hz, "C3", "o", "roots, ζ < 0")
+            unstable = d[d["damping_ratio"] < 0]
+            named = ", ".join(dict.fromkeys(unstable["name"])) if "name" in unstable else ""
+            _locus_panels(ax_z, ax_f, unstable, max_hz, "C3", "o", f"roots, ζ < 0{': ' + named if named else ''}")
         cs = critical[critical["model"] == m].iloc[0]
         title = f"{m}: critical speed {cs['critical_speed_m_s']:.2f} m/s ({cs['critical_speed_mph']:.1f} mph)"
         if isinstance(cs.get("mode"), str):

@@ -14,6 +14,7 @@ from railopt.models.stability import (
     damping_constraints,
     modes,
     root_constraints,
+    root_locus,
 )
 from railopt.models.vehicle import Irregularity, load_vehicle
 
@@ -148,3 +149,19 @@ def test_the_critical_mode_is_named_by_what_hunts(vehicle: str, conicity, expect
     if track == "flexible":
         assert (table["name"] == "track").sum() == len(v.wheelsets)  # one track roll per wheelset
         assert table.loc[table["name"] == "track", "track_share"].min() > 0.9
+
+
+@pytest.mark.parametrize(("conicity", "expected"), [(0.025, "body hunting"), (0.05, "front bogie hunting")])
+def test_root_locus_names_its_roots_as_the_modes_table_does(conicity: float, expected: str) -> None:
+    v = load_vehicle("manchester-coach").with_parameters({"conicity": conicity})
+    cs = critical_speed(v, "rigid", (1.0, 150.0), tol=0.01)
+    above = cs.speed * 1.005
+    locus = root_locus(v.lateral("rigid"), [cs.speed * 0.9, above]).to_pandas()
+    grows = locus[(locus["speed"] == above) & (locus["real"] > 0)]
+    assert list(grows["name"]) == [expected]
+    # the locus names each oscillatory root as modes() names the same root at the same speed
+    table = modes(v.lateral("rigid"), speed=above)
+    table = table[table["imag"] > 0].sort_values(["imag", "real"]).reset_index(drop=True)
+    at = locus[(locus["speed"] == above) & (locus["imag"] > 0)].reset_index(drop=True)
+    assert np.allclose(at["imag"], table["imag"], rtol=1e-9, atol=1e-9)
+    assert list(at["name"]) == list(table["name"])

@@ -79,6 +79,33 @@ def test_the_constrained_optimum_is_the_best_feasible_point_of_a_dense_grid(tmp_
     assert abs(ev.value - grid_best) <= 1e-3 * grid_best
 
 
+
+@pytest.mark.parametrize("method", ["slsqp", "cobyla", "slp"])
+def test_every_constrained_method_takes_the_stability_rows(tmp_path, method: str) -> None:
+    """SLSQP (gradients), COBYLA (values only) and SLP (gradients, LP steps) solve the same stability-constrained
+    problem: each ends feasible, on the stability boundary (the optimum lies inside the box, held by the roots), at
+    the U that SLSQP finds from a dense set of starts."""
+    cfg = two_variable_flagship(tmp_path)
+    problem = campaign_problem(cfg, cfg.setups()["sd40-2"], "exact", "constrained")
+    reference = multistart(problem, 4, method="slsqp", seed=11, options={"xtol": 1e-10, "ftol": 1e-12})
+    U_ref = reference[reference["success"]]["value"].min()
+    table = multistart(problem, 3, method=method, seed=3)
+    best = table[table["success"]].sort_values("value").iloc[0]
+    x = best[list(problem.space.names)].to_numpy(float)
+    ev = problem.evaluate(x)
+    assert problem.constraint_violation(x, ev) <= 1e-8
+    setup = cfg.setups()["sd40-2"]
+    family = setup.stability["rigid"]
+    params = list(setup.family.parameters)
+    p = setup.parameters(list(problem.space.names), x)[0][[params.index(n) for n in family.parameters]]
+    g_roots, _ = root_constraints(family, p, cfg.stability.target(setup).speeds, cfg.stability.sigma_min)
+    assert np.allclose(ev.g[-len(g_roots):], g_roots, rtol=0, atol=1e-12)  # the stability rows come last
+    assert abs(float(np.max(g_roots))) <= 1e-6 * float(np.max(np.abs(g_roots)))  # ... and one of them is active
+    lower, upper = problem.space.lower, problem.space.upper
+    assert lower[0] * (1 + 1e-3) < x[0] < upper[0] * (1 - 1e-3)  # C13 held by the roots, not by its bounds
+    assert ev.value == pytest.approx(U_ref, rel=1e-6)
+
+
 COACH = '''
 [study]
 name = "coach_hunting"

@@ -484,16 +484,18 @@ def _quantity(cfg: CampaignStudyConfig, setup: ModelSetup, spec: TradeoffSpec):
 
 
 def _unconstrained_best(cfg: CampaignStudyConfig, setup: ModelSetup, model: str, tables: dict) -> dict | None:
-    """The best unconstrained optimum whatever its checks say (for comparison beside the recommended design)."""
+    """The best unconstrained optimum whatever its checks say (for comparison beside the recommended design):
+    the lowest certified peak among each objective's and method's best (the thesis objective's own value
+    underestimates the peak, so values of different objectives are not compared)."""
     names = [v.name for v in cfg.design.variables]
     rows = [t[t["success"]] for (m, prob, _, _), t in tables.items() if m == model and prob == "unconstrained"]
-    rows = [r for r in rows if len(r)]
-    if not rows:
+    candidates = [{n: float(r.sort_values(["value", "start_id"]).iloc[0][n]) for n in names} for r in rows if len(r)]
+    if not candidates:
         return None
-    best = pd.concat(rows).sort_values(["value", "start_id"]).iloc[0]
-    values = {n: float(best[n]) for n in names}
+    peaks = [design_peak(cfg, setup, values) for values in candidates]
+    values = candidates[int(np.argmin(peaks))]
     p = _p(cfg, setup, values)
-    return {"values": values, "U": design_peak(cfg, setup, values),
+    return {"values": values, "U": min(peaks),
             "checks": {name: setup.checks[name](p) for name in cfg.design.checks},
             "constraints": _constraint_peaks(cfg, setup, p)}
 

@@ -133,4 +133,5 @@ def test_main_validate_vehicle_lists_warnings(tmp_path: Path) -> None:
     assert f"warning: {path}: contact.conicity: conicity 2.5 is above 0.5" in text
     path.write_bytes(b"\xff")
     text, code = main_validate_vehicle(str(path))
-    assert (text, code) == (f"railopt: error: {path}: not a text file (byte 0 is not UTF-8); a vehicle file is a TOML file", 2)
+    expected = f"railopt: error: {path}: not a text file (byte 0 is not UTF-8); a vehicle file is a TOML file"
+    assert (text, code) == (expected, 2)
