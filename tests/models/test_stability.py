@@ -52,7 +52,7 @@ def test_stable_over_range_and_unstable_at_lower_end() -> None:
 
 def test_root_locus_table(sd40) -> None:
     rl = root_locus(sd40, [10.0, 20.0], track="rigid").to_pandas()
-    assert list(rl.columns) == ["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz"]
+    assert list(rl.columns) == ["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz", "name"]
     assert isinstance(rl, pd.DataFrame)
     one = rl[rl.speed == 10.0]
     s = sd40.lateral("rigid", speed=10.0).eigenvalues()
