@@ -60,7 +60,7 @@ def test_family_members_and_the_abscissa_sign_around_the_critical_speed() -> Non
     locus = root_locus(fam, [0.5 * exact, exact, 2 * exact])
     assert locus.roots.shape == (3, 4)
     df = locus.to_pandas()
-    assert list(df.columns) == ["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz"]
+    assert list(df.columns) == ["speed", "mode", "real", "imag", "damping_ratio", "frequency_hz", "name"]
     # at the critical speed one root pair sits on the imaginary axis
     at_crit = locus.roots[1]
     assert np.min(np.abs(at_crit.real)) < 1e-6 * np.max(np.abs(at_crit))
