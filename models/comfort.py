@@ -55,7 +55,6 @@ the ends are wrapped — discard the first and last 1/f₁ = 2.5 s if that matte
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -64,7 +63,7 @@ from pathlib import Path
 import numpy as np
 
 from railopt.models.units import RAD_PER_HZ as TWO_PI
-from railopt.models.validation import number
+from railopt.models.validation import number, read_number_table
 
 BLOCK_S = 5.0  # EN 12299 RMS block length (s)
 PsdLike = Callable[[np.ndarray], np.ndarray] | None
@@ -226,35 +225,13 @@ def read_accelerations(path: str | Path) -> AccelerationRecord:
         Naming the file and the row: wrong column count, non-numeric or non-finite values, time not
         strictly increasing or not uniformly sampled (deviation > 1e-6 of the step), fewer than 2 rows.
     """
+    arr, rows = read_number_table(path, ("time_s", "ax", "ay", "az"))
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ValueError(f"path: cannot read {str(p)!r}: {exc.strerror}") from exc
-    data: list[list[float]] = []
-    rows: list[int] = []
-    for i, row in enumerate(csv.reader(text.splitlines()), start=1):
-        cells = [c.strip() for c in row]
-        if not any(cells):
-            continue
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            if i == 1:
-                continue
-            raise ValueError(f"{p}: row {i}: not numbers: {row!r}") from None
-        if len(vals) != 4:
-            raise ValueError(f"{p}: row {i}: expected 4 columns (time_s, ax, ay, az), got {len(vals)}")
-        if not all(math.isfinite(v) for v in vals):
-            raise ValueError(f"{p}: row {i}: non-finite value")
-        if data and vals[0] <= data[-1][0]:
-            raise ValueError(f"{p}: row {i}: time must increase strictly ({vals[0]} after {data[-1][0]})")
-        data.append(vals)
-        rows.append(i)
-    if len(data) < 2:
-        raise ValueError(f"{p}: at least two data rows are needed, got {len(data)}")
-    arr = np.array(data)
     dt = np.diff(arr[:, 0])
+    back = np.flatnonzero(dt <= 0)
+    if back.size:
+        k = int(back[0])
+        raise ValueError(f"{p}: row {rows[k + 1]}: time must increase strictly ({arr[k + 1, 0]} after {arr[k, 0]})")
     step = float(np.median(dt))
     bad = np.flatnonzero(np.abs(dt - step) > 1e-6 * step)
     if bad.size:

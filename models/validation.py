@@ -7,8 +7,10 @@ booleans where numbers belong, NaN and infinities are refused.
 
 from __future__ import annotations
 
+import csv
 import math
 from numbers import Real
+from pathlib import Path
 
 import numpy as np
 
@@ -136,3 +138,46 @@ def frequencies_arg(omega: object = None, frequencies_hz: object = None, omega_r
     value is refused (see :func:`band_arg`).  Returns rad/s, 1-D."""
     return np.asarray(_in_rad_s(omega, frequencies_hz, omega_rad_s, ("omega", "frequencies_hz", "omega_rad_s"),
                                 lambda value, name, unit: frequencies_rad_s(value, name)), dtype=float)
+
+
+_COUNT_WORDS = {2: "two", 3: "three", 4: "four"}
+
+
+def read_number_table(path: str | Path, columns: tuple[str, ...]) -> tuple[np.ndarray, list[int]]:
+    """The rows of a CSV file of numbers, ``(values (rows, len(columns)), 1-based file row of each)``.
+
+    A first row that does not parse as numbers is a header; blank rows and empty cells are skipped.
+
+    Raises
+    ------
+    ValueError
+        ``path: cannot read ...``, or naming the file and the row: a cell that is not a number, a wrong
+        number of columns (``columns`` names them, with units), a non-finite value; fewer than two data rows.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"path: cannot read {str(p)!r}: {exc.strerror}") from exc
+    n = len(columns)
+    data: list[list[float]] = []
+    rows: list[int] = []
+    for i, row in enumerate(csv.reader(text.splitlines()), start=1):
+        cells = [c.strip() for c in row if c.strip() != ""]
+        if not cells:
+            continue
+        try:
+            vals = [float(c) for c in cells]
+        except ValueError:
+            if i == 1:
+                continue  # header
+            raise ValueError(f"{p}: row {i}: not {_COUNT_WORDS.get(n, n)} numbers: {row!r}") from None
+        if len(vals) != n:
+            raise ValueError(f"{p}: row {i}: expected {n} columns ({', '.join(columns)}), got {len(vals)}")
+        if not all(math.isfinite(v) for v in vals):
+            raise ValueError(f"{p}: row {i}: non-finite value")
+        data.append(vals)
+        rows.append(i)
+    if len(data) < 2:
+        raise ValueError(f"{p}: at least two data rows are needed, got {len(data)}")
+    return np.array(data), rows

@@ -42,7 +42,6 @@ Asking a spectrum for a wavenumber outside its validity is a ``ValueError`` nami
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -50,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from railopt.models.units import RAD_PER_HZ as TWO_PI
-from railopt.models.validation import number, real_array
+from railopt.models.validation import number, read_number_table, real_array
 
 CM2_TO_M2 = 1e-4
 FRA_K = 0.25
@@ -260,39 +259,17 @@ def read_spectrum_table(path: str | Path) -> TabulatedSpectrum:
     (1-based) row: fewer than two data rows, a non-numeric or non-finite cell, a non-positive wavenumber
     or PSD, wavenumbers not strictly increasing.
     """
+    table, rows = read_number_table(path, ("wavenumber rad/m", "PSD m²/(rad/m)"))
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ValueError(f"path: cannot read {str(p)!r}: {exc.strerror}") from exc
-    rows = list(csv.reader(text.splitlines()))
-    wn: list[float] = []
-    ps: list[float] = []
-    for i, row in enumerate(rows, start=1):
-        cells = [c.strip() for c in row if c.strip() != ""]
-        if not cells:
-            continue
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            if i == 1:
-                continue  # header
-            raise ValueError(f"{p}: row {i}: not two numbers: {row!r}") from None
-        if len(vals) != 2:
-            raise ValueError(f"{p}: row {i}: expected 2 columns (wavenumber rad/m, PSD m²/(rad/m)), got {len(vals)}")
-        w, s = vals
-        if not (math.isfinite(w) and math.isfinite(s)):
-            raise ValueError(f"{p}: row {i}: non-finite value")
+    for k, (w, s) in enumerate(table):
+        i = rows[k]
         if w <= 0:
             raise ValueError(f"{p}: row {i}: wavenumber must be positive, got {w}")
         if s <= 0:
             raise ValueError(f"{p}: row {i}: PSD must be positive, got {s}")
-        if wn and w <= wn[-1]:
-            raise ValueError(f"{p}: row {i}: wavenumbers must increase strictly ({w} after {wn[-1]})")
-        wn.append(w)
-        ps.append(s)
-    if len(wn) < 2:
-        raise ValueError(f"{p}: at least two data rows are needed, got {len(wn)}")
+        if k and w <= table[k - 1, 0]:
+            raise ValueError(f"{p}: row {i}: wavenumbers must increase strictly ({w} after {table[k - 1, 0]})")
+    wn, ps = table[:, 0], table[:, 1]
     w_arr = real_array("wavenumbers", wn)
     s_arr = real_array("values", ps)
     w_arr.setflags(write=False)

@@ -177,7 +177,7 @@ def test_csv_round_trip(tmp_path):
     ("time_s,ax,ay,az\n0,0,0,0\n0.01,0,0,0\n0.01,0,0,0\n", "row 4: time must increase"),
     ("0,0,0,0\n0.01,0,0,0\n0.03,0,0,0\n0.04,0,0,0\n", "row 3: non-uniform sampling"),
     ("0,0,0,0\n0.01,0,0\n", "row 2: expected 4 columns"),
-    ("0,0,0,0\n0.01,0,x,0\n", "row 2: not numbers"),
+    ("0,0,0,0\n0.01,0,x,0\n", "row 2: not four numbers"),
     ("0,0,0,0\n", "at least two data rows"),
 ])
 def test_bad_acceleration_csv_names_file_and_row(tmp_path, body, fragment):
