@@ -144,14 +144,14 @@ def root_locus(model: object, speeds: Sequence[float], track: str | None = None)
         A speed that is not a positive finite number (naming ``speeds[i]``), a model without ``at(speed=S)``.
     """
     S = _speeds(speeds)
-    counted = _Counted(model, track)
+    resolved = _resolve(model, track)
+    groups, main = getattr(resolved, "groups", None), getattr(resolved, "main_body", None)
     roots, names = [], []
     for v in S:
-        system = counted.at(float(v))
-        counted.solves += 1
+        system = resolved.at(speed=float(v))
         order = mode_order(system.modal().s)
         roots.append(system.modal().s[order])
-        names.append([row["name"] for row in _named_roots(system, order, counted.groups, counted.main)])
+        names.append([row["name"] for row in _named_roots(system, order, groups, main)])
     return RootLocus(S, np.array(roots), np.array(names, dtype=object))
 
 
@@ -303,8 +303,7 @@ def _critical_root(counted: _Counted, speed: float) -> tuple[float, str, str]:
     n = system.n
     real = np.where(np.abs(m.s) > NEUTRAL_ROOT * np.max(np.abs(m.s)), m.s.real, -np.inf)
     j = int(np.argmax(real))
-    zeta = -m.s[j].real / abs(m.s[j])
-    name, _, _ = mode_name(system.names, _shares(system, m.V[:n, j]), zeta, counted.groups, counted.main)
+    name = _named_roots(system, [j], counted.groups, counted.main)[0]["name"]
     return (float(rad_s_to_hz(abs(m.s[j].imag))), name, system.names[int(np.argmax(np.abs(m.V[:n, j])))])
 
 
