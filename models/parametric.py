@@ -108,10 +108,7 @@ class ParametricSystem:
     """
 
     def __init__(
-        self,
-        M0: np.ndarray,
-        C0: np.ndarray,
-        K0: np.ndarray,
+        self, M0: np.ndarray, C0: np.ndarray, K0: np.ndarray,
         F0: FamilyForcing | None = None,
         output: np.ndarray | None = None,
         parts: Mapping[str, ParameterPart] | None = None,

@@ -105,10 +105,8 @@ def hertz_ellipse(N: float, E: float, nu: float, A: float, B: float) -> HertzEll
 
     Parameters
     ----------
-    N : float
-        Normal load, N.
-    E : float
-        Young's modulus, Pa.
+    N, E : float
+        Normal load (N) and Young's modulus (Pa).
     nu : float
         Poisson's ratio.
     A, B : float

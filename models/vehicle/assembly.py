@@ -25,54 +25,77 @@ if TYPE_CHECKING:
 TRACKS = ("rigid", "flexible")
 
 
-@dataclass(frozen=True)
-class Assembly:
-    """Matrices over all coordinates z (6 per body, then the prescribed inputs).
+@dataclass(frozen=True, eq=False)
+class SuspensionMatrices:
+    """Second-order matrices with one weight matrix per suspension parameter: what an assembly and a view share.
+
+    ``K = K0 + Σ p_i K_i``, ``C = C0 + Σ p_i C_i + C_creep / S`` over the parameters in ``parts``
+    ((4.50), the one summation being :func:`~railopt.models.parametric.affine`).
 
     Attributes
     ----------
     coordinates : tuple of str
-        All coordinates z; the last ``len(inputs)`` are the prescribed inputs.
+        The coordinates the matrices span (``"<body>.<dof>"``).
     inputs : tuple of str
         Rail irregularity coordinates ``"<wheelset>_rail.v"`` (alignment), ``".w"`` (vertical
         profile) and on rigid track ``".alpha"`` (cross level).
     M, K0, C0, C_creep : (n, n) ndarray
-        Mass, constant stiffness and damping, and creep damping times speed.
+        Mass, constant stiffness, constant damping, creep damping times speed (N·s).
     parts : dict
-        Parameter id -> (``"K"`` or ``"C"``, weight matrix).
+        Parameter id -> (``"K"`` or ``"C"``, weight matrix (n, n)).
     values : dict
-        Parameter id -> value used by :meth:`K` and :meth:`C`.
-    T, T_in : ndarray
-        ``z = T x + T_in u`` (B.1.48).
-    independent : tuple of str
-        Names of x.
+        Parameter id -> value (SI).
     """
 
     coordinates: tuple[str, ...]
     inputs: tuple[str, ...]
-    bodies: tuple[Body, ...]
     M: np.ndarray
     K0: np.ndarray
     C0: np.ndarray
     C_creep: np.ndarray
     parts: dict[str, tuple[str, np.ndarray]]
     values: dict[str, float]
+
+    def weighted(self, kind: str, base: np.ndarray, stacks: dict[str, np.ndarray] | None = None,
+                 skip: tuple[str, ...] = ()) -> np.ndarray:
+        """``base + Σ p_i W_i`` over the parameters of ``kind`` (``"K"`` or ``"C"``) not in ``skip``, with
+        ``W_i`` from ``stacks`` (parameter id -> matrix) or else the parameter's own weight matrix."""
+        ids = [k for k, (kd, _) in self.parts.items() if kd == kind and k not in skip]
+        weights = self.parts if stacks is None else {k: (kind, stacks[k]) for k in ids}
+        stack = np.array([weights[k][1] for k in ids]).reshape(len(ids), *base.shape)
+        return affine(base, stack, np.array([self.values[k] for k in ids]))
+
+
+@dataclass(frozen=True, eq=False)
+class Assembly(SuspensionMatrices):
+    """Matrices over all coordinates z (6 per body, then the prescribed inputs).
+
+    Attributes
+    ----------
+    coordinates : tuple of str
+        All coordinates z; the last ``len(inputs)`` are the prescribed inputs.
+    bodies : tuple of Body
+        Every body, the lumped track bodies included on flexible track.
+    T, T_in : ndarray
+        ``z = T x + T_in u`` (B.1.48).
+    independent : tuple of str
+        Names of x.
+
+    The other attributes are those of :class:`SuspensionMatrices`.
+    """
+
+    bodies: tuple[Body, ...]
     T: np.ndarray
     T_in: np.ndarray
     independent: tuple[str, ...]
 
-    def _weighted(self, kind: str, base: np.ndarray) -> np.ndarray:
-        ids = [k for k, (kd, _) in self.parts.items() if kd == kind]
-        stack = np.array([self.parts[k][1] for k in ids]).reshape(len(ids), *base.shape)
-        return affine(base, stack, np.array([self.values[k] for k in ids]))
-
     def K(self) -> np.ndarray:
         """Full stiffness at the stored parameter values, N/m and N·m/rad."""
-        return self._weighted("K", self.K0)
+        return self.weighted("K", self.K0)
 
     def C_const(self) -> np.ndarray:
         """Speed-independent damping at the stored parameter values, N·s/m."""
-        return self._weighted("C", self.C0)
+        return self.weighted("C", self.C0)
 
     def C(self, speed: float) -> np.ndarray:
         """Full damping at forward speed ``speed`` (m/s): ``C_const + C_creep / S``."""
@@ -166,5 +189,5 @@ def assemble(vehicle: Vehicle, track: str = "rigid") -> Assembly:
         else:
             relations += hinge(body, byname[c.to], c.axis, c.point, origin=f"hinge {c.body}->{c.to}")
     T, T_in, independent = transformation(coordinates, relations, inputs)
-    return Assembly(coordinates, tuple(inputs), tuple(bodies), M, K0, C0, C_creep, parts, values, T, T_in,
-                    independent)
+    return Assembly(coordinates=coordinates, inputs=tuple(inputs), M=M, K0=K0, C0=C0, C_creep=C_creep, parts=parts,
+                    values=values, bodies=tuple(bodies), T=T, T_in=T_in, independent=independent)

@@ -42,28 +42,29 @@ class ContactSpec:
 
     ``creep = "given"`` uses ``coefficients``; ``"hertz"`` computes them per wheel from the Hertz
     ellipse under half the axle load (``railopt.models.contact``).  ``conicity`` may come from a
-    Δr table (``delta_r_y``, ``delta_r``, ``amplitude``) by the EN 15302 method.
+    Δr table (``delta_r_y``, ``delta_r``, ``amplitude``) by the EN 15302 method.  Every field is given: the
+    defaults are the file schema's (:class:`~railopt.models.vehicle.schema.ContactSchema`), in one place.
     """
 
     r0: float
     e0: float
     conicity: float
-    theta0: float = 0.0
-    epsilon: float = 0.0
-    eta: float = 0.0
-    creep: str = "given"
-    coefficients: Creep | None = None
-    creep_factor: float = 1.0
-    spin: bool = True
-    gravity_stiffness: bool = True
-    axle_load: float | None = None
-    youngs_modulus: float = 2.07e11
-    poisson_ratio: float = 0.28
-    shear_modulus: float | None = None
-    theory: str = "kalker"
-    rail_head_radius: float = 0.254
-    wheel_transverse_radius: float = math.inf
-    source: str = "estimate"
+    theta0: float
+    epsilon: float
+    eta: float
+    creep: str
+    coefficients: Creep | None
+    creep_factor: float
+    spin: bool
+    gravity_stiffness: bool
+    axle_load: float | None
+    youngs_modulus: float
+    poisson_ratio: float
+    shear_modulus: float | None
+    theory: str
+    rail_head_radius: float
+    wheel_transverse_radius: float
+    source: str
 
     def __post_init__(self) -> None:
         if self.creep not in CREEP_MODES:

@@ -24,9 +24,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from railopt.models.parametric import ParameterPart, ParametricSystem, affine
+from railopt.models.parametric import ParameterPart, ParametricSystem
 from railopt.models.system import LinearSystem
 from railopt.models.validation import number
+from railopt.models.vehicle.assembly import SuspensionMatrices
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -53,7 +54,7 @@ class BodyPlace:
 
 
 @dataclass(frozen=True, eq=False)
-class VehicleView:
+class VehicleView(SuspensionMatrices):
     """Linear model of one block of coordinates of an assembled vehicle.
 
     Attributes
@@ -66,12 +67,8 @@ class VehicleView:
         Independent coordinates x (``"<body>.<dof>"``), m and rad.
     inputs : tuple of str
         Prescribed rail input coordinates u of this block.
-    M, K0, C0, C_creep : (n, n) ndarray
-        Mass, constant stiffness, constant damping, creep damping times speed (N·s).
-    parts : dict
-        Parameter id -> (``"K"`` or ``"C"``, weight matrix (n, n)).
-    values : dict
-        Parameter id -> value (SI).
+    M, K0, C0, C_creep, parts, values
+        The block's reduced matrices, as in :class:`~railopt.models.vehicle.assembly.SuspensionMatrices`.
     M_in, K_in0, C_in0, C_in_creep : (n, m) ndarray
         Input matrices (constant parts); ``in_parts`` per parameter id.
     speed : float or None
@@ -101,14 +98,6 @@ class VehicleView:
 
     name: str
     track: str
-    coordinates: tuple[str, ...]
-    inputs: tuple[str, ...]
-    M: np.ndarray
-    K0: np.ndarray
-    C0: np.ndarray
-    C_creep: np.ndarray
-    parts: dict[str, tuple[str, np.ndarray]]
-    values: dict[str, float]
     M_in: np.ndarray
     K_in0: np.ndarray
     C_in0: np.ndarray
@@ -169,21 +158,12 @@ class VehicleView:
         return replace(self, values=new)
 
     # ------------------------------------------------------------------ the family
-    def _split(self, ids: Sequence[str], kind: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(stack of weight matrices, their values) of the parameters of ``kind`` not in ``ids``, and of the input
-        parts: what is folded into the constant part at the view's values."""
-        others = [k for k, (kd, _) in self.parts.items() if kd == kind and k not in ids]
-        n, m = self.n_dof, len(self.inputs)
-        stack = np.array([self.parts[k][1] for k in others]).reshape(len(others), n, n)
-        in_stack = np.array([self.in_parts[k] for k in others]).reshape(len(others), n, m)
-        return stack, in_stack, np.array([self.values[k] for k in others])
-
     def _folded(self, ids: Sequence[str]) -> dict[str, np.ndarray]:
-        """Constant matrices with every parameter not in ``ids`` at its value (the one summation: ``affine``)."""
-        Ks, Kin, kv = self._split(ids, "K")
-        Cs, Cin, cv = self._split(ids, "C")
-        return {"K": affine(self.K0, Ks, kv), "C": affine(self.C0, Cs, cv),
-                "K_in": affine(self.K_in0, Kin, kv), "C_in": affine(self.C_in0, Cin, cv)}
+        """Constant matrices with every parameter not in ``ids`` at its value."""
+        skip = tuple(ids)
+        return {"K": self.weighted("K", self.K0, skip=skip), "C": self.weighted("C", self.C0, skip=skip),
+                "K_in": self.weighted("K", self.K_in0, self.in_parts, skip),
+                "C_in": self.weighted("C", self.C_in0, self.in_parts, skip)}
 
     def family(self, names: Sequence[str] | None = None, input: Irregularity | RailInput | None = None,
                outputs: Sequence[str | PointOutput] | str | PointOutput | None = None,
