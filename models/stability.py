@@ -347,11 +347,13 @@ def readable(group: str) -> str:
     return re.sub(r"(\D)(\d+)$", r"\1 \2", group)
 
 
-def _shares(system: LinearSystem, vector: np.ndarray) -> np.ndarray:
-    """Each coordinate's share of the modal kinetic energy Re(v̄_i (M v)_i) / vᴴMv (sums to 1)."""
-    e = np.real(np.conj(vector) * (system.M @ vector))
-    total = float(np.sum(e))
-    return e / total if total > 0 else np.full(len(e), 1.0 / len(e))
+def _shares(system: LinearSystem, vectors: np.ndarray) -> np.ndarray:
+    """Each coordinate's share of the modal kinetic energy Re(v̄_i (M v)_i) / vᴴMv (sums to 1), for one mode
+    vector (n,) or for the columns of (n, k) at once."""
+    e = np.real(np.conj(vectors) * (system.M @ vectors))
+    total = np.sum(e, axis=0)
+    uniform = np.full(e.shape, 1.0 / e.shape[0])
+    return np.where(total > 0, e / np.where(total > 0, total, 1.0), uniform)
 
 
 def mode_name(names: Sequence[str], shares: np.ndarray, damping_ratio: float,
@@ -435,22 +437,25 @@ def _named_roots(system: LinearSystem, indices: np.ndarray, groups: Mapping[str,
 
 # ---------------------------------------------------------------------------------------------- design constraints
 def _family_rows(family, p, speeds: Sequence[float], exclude: Sequence[str]):
-    """Per speed: the member, its roots one per mode (mode order) and a mask of the kept (vehicle) modes."""
+    """Per speed: the member, its roots one per mode (mode order) and a mask of the kept (vehicle) modes.
+
+    A mode is dropped when neutral, when lumped track bodies carry most of its energy (what
+    :func:`mode_name` calls "track") or, with ``exclude``, when its name, group or a prefix is listed; the
+    names are only worked out when something is excluded (the constraint rows need the mask alone)."""
     groups, main = getattr(family, "groups", None), getattr(family, "main_body", None)
+    track: np.ndarray | None = None
     for S in _speeds(speeds):
         system = family.at(p, speed=float(S))
+        if track is None:
+            track = np.array([_track_body(_body_dof(c)[0]) for c in system.names], dtype=bool)
         m = system.modal()
         idx = mode_order(m.s)[1::2]
-        scale = float(np.max(np.abs(m.s)))
-        keep = np.ones(len(idx), dtype=bool)
-        n = system.n
-        for j, k in enumerate(idx):
-            if abs(m.s[k]) <= NEUTRAL_ROOT * scale:
-                keep[j] = False
-                continue
-            zeta = -m.s[k].real / abs(m.s[k])
-            name, group, _ = mode_name(system.names, _shares(system, m.V[:n, k]), zeta, groups, main)
-            if name == "track" or any(x == name or x == group or name.startswith(x) for x in exclude):
+        roots = m.s[idx]
+        shares = _shares(system, m.V[:system.n, idx])
+        keep = (np.abs(roots) > NEUTRAL_ROOT * float(np.max(np.abs(m.s)))) & (shares[track].sum(axis=0) <= 0.5)
+        for j in np.flatnonzero(keep) if exclude else ():
+            name, group, _ = mode_name(system.names, shares[:, j], -roots[j].real / abs(roots[j]), groups, main)
+            if any(x == name or x == group or name.startswith(x) for x in exclude):
                 keep[j] = False
         yield float(S), system, idx, keep
 

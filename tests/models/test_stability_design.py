@@ -130,6 +130,26 @@ def test_stability_constraint_rows_and_their_gradients(rows) -> None:
         assert np.max(np.abs(J[live, i] - fd[live])) <= 1e-5 * np.max(np.abs(fd[live]))
 
 
+@pytest.mark.parametrize("exclude", [(), ("body",), ("front truck",), ("frame_rear", "body hunting")])
+@pytest.mark.parametrize("track", ["rigid", "flexible"])
+def test_the_kept_rows_are_the_modes_named_by_modes(exclude, track: str) -> None:
+    """The rows' mask (worked out from energy shares, names only when something is excluded) is the one
+    :func:`modes` gives root by root: a row is −1 exactly for a rigid-body, track or excluded mode."""
+    family = load_vehicle("sd40-2").lateral(track).family(["K2", "C13"])
+    speeds = [12.0, 31.0]
+    g, _ = root_constraints(family, family.values, speeds, sigma_min=1e-3, exclude=exclude)
+    for k, S in enumerate(speeds):
+        table = modes(family, speed=S)
+        dropped = (table["name"].isin(["track", "rigid body"])
+                   | table["name"].map(lambda nm: any(nm == x or nm.startswith(x) for x in exclude))
+                   | table["group"].isin(exclude))
+        if exclude:
+            assert dropped.sum() > (table["name"].isin(["track", "rigid body"])).sum()  # the exclusion bites
+        rows = g[k * family.n:(k + 1) * family.n]
+        assert np.array_equal(rows == -1.0, dropped.to_numpy())
+        assert np.allclose(rows[~dropped.to_numpy()], table["real"][~dropped].to_numpy() + 1e-3, rtol=0, atol=1e-12)
+
+
 @pytest.mark.parametrize(("vehicle", "conicity", "expected"), [
     ("manchester-coach", 0.025, "body hunting"),
     ("manchester-coach", 0.05, "front bogie hunting"),
