@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -30,6 +31,48 @@ class _StartTask:
         return self.start, solve(self.problem, self.start.x0, method=self.method, **self.options)
 
 
+@dataclass(frozen=True)
+class _StartBatch:
+    """Several starts in one task, solved one after the other (short starts: dask's per-task cost amortised)."""
+
+    problem: MinimaxProblem
+    starts: tuple[Start, ...]
+    method: str
+    options: dict[str, Any]
+
+    def __call__(self) -> list[tuple[Start, SolveResult]]:
+        return [(s, solve(self.problem, s.x0, method=self.method, **self.options)) for s in self.starts]
+
+
+@dataclass(frozen=True)
+class _LostBatch:
+    starts: tuple[Start, ...]
+
+
+MAX_BATCH = 8  # starts per task at most: a killed campaign redoes at most this many per worker
+TASKS_PER_WORKER = 8  # at least this many tasks per worker, so that uneven starts still balance
+TASK_SECONDS = 0.25  # a batch is made about this long: dask's per-task cost is a few ms of the worker's time
+
+
+def batch_size(n_todo: int, workers: int, start_seconds: float) -> int:
+    """Starts per dask task: enough for a task of ``TASK_SECONDS`` at ``start_seconds`` a start (the median
+    of the first starts), no more than keeps ``TASKS_PER_WORKER`` tasks per worker, 1 to ``MAX_BATCH``."""
+    enough = math.ceil(TASK_SECONDS / max(start_seconds, 1e-9))
+    balanced = n_todo // max(TASKS_PER_WORKER * workers, 1)
+    return int(max(1, min(MAX_BATCH, enough, balanced)))
+
+
+def _workers(client: Any) -> int:
+    try:
+        return max(sum(client.nthreads().values()), 1)
+    except Exception:  # noqa: BLE001  (a scheduler that does not answer: one start per task, as before)
+        return 1 << 30
+
+
+def _lost_batch(task: _StartBatch, lost: WorkerLost) -> _LostBatch:
+    return _LostBatch(task.starts)
+
+
 def _lost_start(task: _StartTask, lost: WorkerLost) -> tuple[Start, SolveResult]:
     """The row of a start whose task killed every worker it ran on: x = x0, U = inf, status ``worker_lost``."""
     x0 = np.asarray(task.start.x0, dtype=float)
@@ -53,6 +96,7 @@ def multistart(
     progress: Callable[[int, int], None] | None = None,
     cluster_xtol: float = 1e-3,
     retry_failed: bool = False,
+    batch: int | None = None,
 ) -> pd.DataFrame:
     """Solve from user ``points`` plus ``n_starts`` quasi-random starts; one row per start.
 
@@ -81,9 +125,14 @@ def multistart(
     retry_failed : bool
         Re-run the stored starts whose task killed every worker it ran on (status ``worker_lost``);
         by default a resume skips them, as it skips every finished start.
+    batch : int, optional
+        Starts per dask task; default: one start on each worker first, then :func:`batch_size` from the
+        median time of those (tasks of about 0.25 s, at least eight per worker, 1 to 8 starts).
+        Each start is solved, stored and reported exactly as alone: batching changes no number.
 
     A start whose task kills every dask worker that runs it (a crash in native code, out of memory)
-    is stored with status ``worker_lost`` and the campaign goes on with the others.
+    is stored with status ``worker_lost`` and the campaign goes on with the others.  A batch whose task
+    was lost is run again one start per task, so only the start that crashes is stored as lost.
 
     Raises
     ------
@@ -101,6 +150,8 @@ def multistart(
         success, cluster``.
     """
     method_options(method, options)  # validates method and options before any work is done
+    if batch is not None and (isinstance(batch, bool) or not isinstance(batch, int) or batch < 1):
+        raise ValueError(f"batch: must be a whole number of starts per task >= 1, got {batch!r}")
     starts = start_points(problem.space, n_starts, sampler=sampler, seed=seed, points=points)
     owned = store is None
     if owned:
@@ -112,12 +163,40 @@ def multistart(
         if progress is not None:
             progress(done, total)
         user_options = dict(options or {})
-        tasks = [_StartTask(problem, s, method, user_options) for s in todo]
-        for start, result in map_unordered(call, tasks, client=client, on_lost=_lost_start):
+
+        def record(start: Start, result: SolveResult) -> None:
+            nonlocal done
             store.add_start(start.start_id, start.origin, seed, result)
             done += 1
             if progress is not None:
                 progress(done, total)
+
+        alone = todo
+        if client is not None and batch != 1:
+            workers = _workers(client)
+            if batch is None:  # one start per worker first: how long a start takes decides the batch
+                probe, todo = todo[:workers], todo[workers:]
+                seconds = []
+                for start, result in map_unordered(call, [_StartTask(problem, s, method, user_options) for s in probe],
+                                                   client=client, on_lost=_lost_start):
+                    record(start, result)
+                    if result.status != "worker_lost":
+                        seconds.append(result.wall_time)
+                size = batch_size(len(todo), workers, float(np.median(seconds)) if seconds else 0.0)
+            else:
+                size = batch
+            alone = todo if size == 1 else []
+            batches = [] if size == 1 else [_StartBatch(problem, tuple(todo[i:i + size]), method, user_options)
+                       for i in range(0, len(todo), size)]
+            for out in map_unordered(call, batches, client=client, on_lost=_lost_batch):
+                if isinstance(out, _LostBatch):
+                    alone.extend(out.starts)  # which start crashed is not known: each again, alone
+                    continue
+                for start, result in out:
+                    record(start, result)
+        tasks = [_StartTask(problem, s, method, user_options) for s in alone]
+        for start, result in map_unordered(call, tasks, client=client, on_lost=_lost_start):
+            record(start, result)
         table = store.starts()
     finally:
         if owned:

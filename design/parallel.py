@@ -47,7 +47,7 @@ SCHEDULER_TIMEOUT_ENV = "RAILOPT_SCHEDULER_TIMEOUT"
 DASK_LOGS_ENV = "RAILOPT_DASK_LOGS"
 DEFAULT_SCHEDULER_TIMEOUT = 5.0
 SCHEDULER_MARGIN = 5.0  # s beyond the scheduler timeout that giving up on a silent or dead scheduler may take
-_POLL = 0.25  # s between checks of the scheduler's health while waiting for results
+_POLL = 1.0  # s between checks of the scheduler's health while waiting for results (each costs the scheduler CPU)
 LOCAL_NO_WORKERS_LIMIT = 120.0  # s the embedded LocalCluster may have no worker (restarting) before an error
 
 
@@ -474,7 +474,12 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     # holds one task at a time (worker-saturation 1), so a death is held against the task that caused it only.
     with (
         _quiet_dask_logs(),
-        dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0}),
+        dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0,
+                         # a worker's own threads take the GIL from the solving thread: its sampling profiler
+                         # (every 10 ms), the event-loop tick (20 ms), memory (100 ms) and system (500 ms) monitors
+                         "distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "200ms",
+                         "distributed.worker.memory.monitor-interval": "500ms",
+                         "distributed.admin.system-monitor.interval": "2s"}),
         LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                      # the scheduler's HTTP routes on a free local port, not 8787 (taken: a warning on stderr)
                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},

@@ -97,6 +97,33 @@ def test_a_start_that_kills_its_worker_is_stored_as_lost_and_not_retried_unless_
     np.testing.assert_array_equal(rows.loc[ok[ok].index, "value"], kept.loc[ok, "value"])
 
 
+@pytest.mark.timeout(240)
+def test_a_batch_with_a_crashing_start_loses_only_that_start(tmp_path: Path) -> None:
+    """Starts batched several per task: a batch lost to a crash is run again one start per task, so exactly the
+    starts that crash (a < 0.12, known from x0) are stored as lost, and every other row is the serial one."""
+    log = tmp_path / "crashes.txt"
+    args = {"n_starts": 23, "method": "slsqp", "seed": 11, "points": [[0.05, 0.5]]}
+    serial = multistart(MinimaxProblem(VARIABLES, Poisoned(str(log), crash=False)), **args)
+    poisoned = MinimaxProblem(VARIABLES, Poisoned(str(log)))
+    with dask_client(workers=2) as client:
+        table = multistart(poisoned, client=client, batch=4, **args)
+    crashing = set(serial.loc[serial["x0_a"] < 0.12, "start_id"])
+    assert 2 <= len(crashing) < 8  # the case has something to isolate, and more than one batch survives
+    assert set(table.loc[table["status"] == "worker_lost", "start_id"]) == crashing
+    kept = table[~table["start_id"].isin(crashing)].reset_index(drop=True)
+    ref = serial[~serial["start_id"].isin(crashing)].reset_index(drop=True)
+    for col in ("start_id", "a", "b", "value", "evaluations", "status"):
+        np.testing.assert_array_equal(kept[col], ref[col])
+    np.testing.assert_allclose(kept["value"], U_STAR, atol=1e-7)  # closed form
+
+
+def test_batch_must_be_a_positive_whole_number() -> None:
+    problem = MinimaxProblem(VARIABLES, _f)
+    for bad in (0, -2, 1.5, True, "4"):
+        with pytest.raises(ValueError, match="batch"):
+            multistart(problem, 4, batch=bad)
+
+
 # ---------------------------------------------------------------------- unpicklable problems
 
 

@@ -139,6 +139,30 @@ def test_local_cluster_gives_the_serial_table(client):
     pd.testing.assert_frame_equal(parallel[DETERMINISTIC], serial[DETERMINISTIC])
 
 
+def test_batched_starts_give_the_serial_table(client):
+    """Short starts go several to a task (the batch chosen from the first starts' time): same rows, same order."""
+    tp = minimax_test_problems()["CB2"]
+    serial = multistart(tp.problem, 150, seed=4, points=[tp.start])
+    calls = []
+
+    def progress(done, total):
+        calls.append((done, total))
+
+    parallel = multistart(tp.problem, 150, seed=4, points=[tp.start], client=client, progress=progress)
+    pd.testing.assert_frame_equal(parallel[DETERMINISTIC], serial[DETERMINISTIC])
+    assert calls[0] == (0, 151) and calls[-1] == (151, 151) and len(calls) == 152  # every start reported
+
+
+def test_batch_size_rule() -> None:
+    from railopt.design.multistart import MAX_BATCH, batch_size
+
+    assert batch_size(64, 2, 0.04) == 4  # 7 starts make 0.25 s, but 64 starts keep 8 tasks per worker at 4
+    assert batch_size(10_000, 2, 0.04) == 7  # ceil(0.25 / 0.04)
+    assert batch_size(10_000, 2, 1e-4) == MAX_BATCH
+    assert batch_size(10_000, 2, 0.5) == 1  # long starts: one per task
+    assert batch_size(3, 2, 1e-4) == 1
+
+
 def test_local_cluster_gives_the_serial_table_for_a_lapack_model(client):
     """Eigen-decompositions and complex solves round identically in workers and in-process."""
     from railopt.studies.cli import STUDIES_DIR
