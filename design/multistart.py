@@ -131,8 +131,8 @@ def multistart(
         Each start is solved, stored and reported exactly as alone: batching changes no number.
 
     A start whose task kills every dask worker that runs it (a crash in native code, out of memory)
-    is stored with status ``worker_lost`` and the campaign goes on with the others.  A batch whose task
-    was lost is run again one start per task, so only the start that crashes is stored as lost.
+    is stored with status ``worker_lost`` and the campaign goes on with the others.  The starts of a lost
+    task run again one at a time, alone on the cluster, so only a start that crashes by itself is stored as lost.
 
     Raises
     ------
@@ -164,39 +164,46 @@ def multistart(
             progress(done, total)
         user_options = dict(options or {})
 
+        seconds: list[float] = []  # solve times of the starts recorded so far
+
         def record(start: Start, result: SolveResult) -> None:
             nonlocal done
             store.add_start(start.start_id, start.origin, seed, result)
+            seconds.append(result.wall_time)
             done += 1
             if progress is not None:
                 progress(done, total)
 
-        alone = todo
-        if client is not None and batch != 1:
-            workers = _workers(client)
-            if batch is None:  # one start per worker first: how long a start takes decides the batch
-                probe, todo = todo[:workers], todo[workers:]
-                seconds = []
-                for start, result in map_unordered(call, [_StartTask(problem, s, method, user_options) for s in probe],
-                                                   client=client, on_lost=_lost_start):
-                    record(start, result)
-                    if result.status != "worker_lost":
-                        seconds.append(result.wall_time)
-                size = batch_size(len(todo), workers, float(np.median(seconds)) if seconds else 0.0)
-            else:
-                size = batch
-            alone = todo if size == 1 else []
-            batches = [] if size == 1 else [_StartBatch(problem, tuple(todo[i:i + size]), method, user_options)
-                       for i in range(0, len(todo), size)]
-            for out in map_unordered(call, batches, client=client, on_lost=_lost_batch):
+        def run(tasks: list[_StartBatch]) -> list[Start]:
+            """Record every start of ``tasks``; return the starts of the tasks that were lost."""
+            lost: list[Start] = []
+            for out in map_unordered(call, tasks, client=client, on_lost=_lost_batch):
                 if isinstance(out, _LostBatch):
-                    alone.extend(out.starts)  # which start crashed is not known: each again, alone
+                    lost.extend(out.starts)
                     continue
                 for start, result in out:
                     record(start, result)
-        tasks = [_StartTask(problem, s, method, user_options) for s in alone]
-        for start, result in map_unordered(call, tasks, client=client, on_lost=_lost_start):
-            record(start, result)
+            return lost
+
+        def batches(starts: list[Start], size: int) -> list[_StartBatch]:
+            return [_StartBatch(problem, tuple(starts[i:i + size]), method, user_options)
+                    for i in range(0, len(starts), size)]
+
+        suspects: list[Start] = []
+        if client is None or batch is not None:
+            suspects = run(batches(todo, batch or 1))
+        else:  # one start per worker first: how long a start takes decides the batch
+            workers = _workers(client)
+            probe, rest = todo[:workers], todo[workers:]
+            suspects = run(batches(probe, 1))
+            size = batch_size(len(rest), workers, float(np.median(seconds)) if seconds else 0.0)
+            suspects += run(batches(rest, size))
+        # A lost task's starts run again one at a time, each alone on the cluster: dask also holds a worker's death
+        # against a task queued there, so only a start that kills two workers by itself is stored as lost.
+        for start in suspects:
+            for start_, result in map_unordered(call, [_StartTask(problem, start, method, user_options)],
+                                                client=client, on_lost=_lost_start):
+                record(start_, result)
         table = store.starts()
     finally:
         if owned:

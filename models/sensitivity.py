@@ -17,7 +17,7 @@ all outputs at once).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -88,14 +88,18 @@ def _partials(system: LinearSystem, omega: float, cols: list[int]) -> tuple[np.n
 
 def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
                      band_rad_s: tuple[float, float] | None = None, exact: bool = False,
-                     outputs: Sequence[str] | None = None) -> dict[str, tuple[ResponseMaxima, np.ndarray]]:
+                     outputs: Sequence[str] | None = None, maxima: Mapping[str, ResponseMaxima] | None = None,
+                     ) -> dict[str, tuple[ResponseMaxima, np.ndarray]]:
     """f_k and their analytic Jacobians ``df_k/dp_i`` (n+2, P) for several outputs of a family member,
     sharing its eigen-decomposition.  The band as ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s).  Entries with
-    f_k = inf (zero damping, singular Z, no steady state) get a zero gradient row."""
+    f_k = inf (zero damping, singular Z, no steady state) get a zero gradient row.  ``maxima``: the
+    :func:`~railopt.models.response_maxima.all_response_maxima` of these outputs already computed with the same
+    band and method (an optimiser asked for the values first), used instead of computing them again."""
     t = _tangent(system)
     lo, hi = band_arg(band, band_hz, band_rad_s)
     names = list(system.output_names if outputs is None else outputs)
-    maxima = all_response_maxima(system, band_rad_s=(lo, hi), exact=exact, outputs=names)
+    if maxima is None or any(n not in maxima for n in names):
+        maxima = all_response_maxima(system, band_rad_s=(lo, hi), exact=exact, outputs=names)
     n, P = system.n, len(t.parameters)
     dwd = damped_frequency_jacobian(system)
     wd = system.damped_frequencies()

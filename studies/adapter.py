@@ -26,6 +26,7 @@ import numpy as np
 from railopt.design import DesignVariable, MinimaxProblem
 from railopt.models import LinearSystem
 from railopt.models.random_response import random_response
+from railopt.models.response_maxima import all_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
 from railopt.models.stability import damping_constraints, root_constraints
 from railopt.studies.catalog import ModelSetup
@@ -119,43 +120,64 @@ class StabilityTarget:
 
 
 class _Evaluator:
-    """f or g at x with its Jacobian, the system of the last x kept (f and g share it)."""
+    """f or g at x, and their Jacobians when the solver asks, the system and the pieces of the last x kept:
+    values first (a derivative-free method stops there), the Jacobian from the same maxima afterwards."""
 
     def __init__(self, setup: ModelSetup, names: Sequence[str]) -> None:
         self.setup, self.names = setup, list(names)
         self._key: bytes | None = None
         self._sys: LinearSystem | None = None
         self._dp: np.ndarray | None = None
+        self._pieces: dict = {}
 
     def system(self, x: np.ndarray) -> tuple[LinearSystem, np.ndarray]:
         key = np.asarray(x, dtype=float).tobytes()
         if key != self._key:
             p, dp = self.setup.parameters(self.names, np.asarray(x, dtype=float))
-            self._sys, self._dp, self._key = self.setup.family.at(p), dp, key
+            self._sys, self._dp, self._key, self._pieces = self.setup.family.at(p), dp, key, {}
         return self._sys, self._dp
 
-    def maxima(self, x: np.ndarray, targets: Sequence[ResponseTarget]) -> tuple[np.ndarray, np.ndarray]:
-        sys, dp = self.system(x)
-        values, jacs = [], []
-        for t in targets:
-            rm, J = maxima_jacobians(sys, band_rad_s=t.band, exact=t.exact, outputs=[t.output])[t.output]
-            values.append(rm.values)
-            jacs.append(J @ dp)
-        return np.concatenate(values), np.vstack(jacs)
+    def _piece(self, x: np.ndarray, name: tuple, compute):
+        self.system(x)  # a new x clears the pieces
+        if name not in self._pieces:
+            self._pieces[name] = compute()
+        return self._pieces[name]
 
-    def rms(self, x: np.ndarray, target: RMSTarget) -> tuple[np.ndarray, np.ndarray]:
-        """The ride objective at x (1,) and its gradient (1, d)."""
-        sys, dp = self.system(x)
-        r = random_response(sys, target.spectrum, target.speed, target.band_hz, target.output, target.rtol)
-        return np.array([target.scale * r.rms]), target.scale * rms_gradient(sys, r, dp)[None, :]
+    def _maxima(self, x: np.ndarray, t: ResponseTarget):
+        sys, _ = self.system(x)
+        return self._piece(x, ("maxima", id(t)), lambda: all_response_maxima(
+            sys, band_rad_s=t.band, exact=t.exact, outputs=[t.output])[t.output])
 
-    def objective(self, x: np.ndarray, target: ResponseTarget | RMSTarget) -> tuple[np.ndarray, np.ndarray]:
+    def maxima(self, x: np.ndarray, targets: Sequence[ResponseTarget]) -> np.ndarray:
+        return np.concatenate([self._maxima(x, t).values for t in targets])
+
+    def maxima_jacobian(self, x: np.ndarray, targets: Sequence[ResponseTarget]) -> np.ndarray:
+        sys, dp = self.system(x)
+        return np.vstack([maxima_jacobians(sys, band_rad_s=t.band, exact=t.exact, outputs=[t.output],
+                                           maxima={t.output: self._maxima(x, t)})[t.output][1] @ dp for t in targets])
+
+    def _rms(self, x: np.ndarray, target: RMSTarget):
+        sys, _ = self.system(x)
+        return self._piece(x, ("rms", id(target)), lambda: random_response(
+            sys, target.spectrum, target.speed, target.band_hz, target.output, target.rtol))
+
+    def objective(self, x: np.ndarray, target: ResponseTarget | RMSTarget) -> np.ndarray:
         if isinstance(target, RMSTarget):
-            return self.rms(x, target)
+            return np.array([target.scale * self._rms(x, target).rms])
         return self.maxima(x, [target])
 
+    def objective_jacobian(self, x: np.ndarray, target: ResponseTarget | RMSTarget) -> np.ndarray:
+        if isinstance(target, RMSTarget):
+            sys, dp = self.system(x)
+            return target.scale * rms_gradient(sys, self._rms(x, target), dp)[None, :]
+        return self.maxima_jacobian(x, [target])
+
     def stability(self, x: np.ndarray, target: StabilityTarget) -> tuple[np.ndarray, np.ndarray]:
-        """The rows of ``target`` at x and their Jacobian in x."""
+        """The rows of ``target`` at x and their Jacobian in x (computed together: the roots' derivatives
+        cost little beside the eigen-solves they share)."""
+        return self._piece(x, ("stability", id(target)), lambda: self._stability(x, target))
+
+    def _stability(self, x: np.ndarray, target: StabilityTarget) -> tuple[np.ndarray, np.ndarray]:
         _, dp = self.system(x)
         p, _ = self.setup.parameters(self.names, np.asarray(x, dtype=float))
         params = list(self.setup.family.parameters)
@@ -175,14 +197,21 @@ class _Evaluator:
         return np.concatenate(values), np.vstack(jacs)
 
     def constraints(self, x: np.ndarray, targets: Sequence[ResponseTarget],
-                    stability: StabilityTarget | None) -> tuple[np.ndarray, np.ndarray]:
+                    stability: StabilityTarget | None) -> np.ndarray:
         parts = [self.maxima(x, targets)] if targets else []
         if stability is not None:
-            parts.append(self.stability(x, stability))
-        return np.concatenate([v for v, _ in parts]), np.vstack([j for _, j in parts])
+            parts.append(self.stability(x, stability)[0])
+        return np.concatenate(parts)
+
+    def constraints_jacobian(self, x: np.ndarray, targets: Sequence[ResponseTarget],
+                             stability: StabilityTarget | None) -> np.ndarray:
+        parts = [self.maxima_jacobian(x, targets)] if targets else []
+        if stability is not None:
+            parts.append(self.stability(x, stability)[1])
+        return np.vstack(parts)
 
     def __getstate__(self) -> dict:  # ship to dask workers without the cached system
-        return {"setup": self.setup, "names": self.names, "_key": None, "_sys": None, "_dp": None}
+        return {"setup": self.setup, "names": self.names, "_key": None, "_sys": None, "_dp": None, "_pieces": {}}
 
 
 def minimax_problem(
@@ -207,7 +236,8 @@ def minimax_problem(
             raise ValueError(f"objective.output: unknown output {objective.output!r}; outputs are "
                              f"{list(setup.family.output_names)}")
     if not constraints and stability is None:
-        return MinimaxProblem(list(variables), lambda x: evaluator.objective(x, objective), jacobian=True)
+        return MinimaxProblem(list(variables), lambda x: evaluator.objective(x, objective),
+                              jacobian=lambda x: evaluator.objective_jacobian(x, objective))
     if stability is not None:
         missing = [t for t in stability.tracks if t not in setup.stability]
         if missing:
@@ -220,8 +250,8 @@ def minimax_problem(
     return MinimaxProblem(
         list(variables),
         lambda x: evaluator.objective(x, objective),
-        jacobian=True,
+        jacobian=lambda x: evaluator.objective_jacobian(x, objective),
         constraints=lambda x: evaluator.constraints(x, targets, stability),
-        constraint_jacobian=True,
+        constraint_jacobian=lambda x: evaluator.constraints_jacobian(x, targets, stability),
         epsilon=epsilon,
     )

@@ -258,6 +258,60 @@ def _cab_rows(repeat: int) -> list[dict]:
     return rows
 
 
+MEMORY_LIMIT_MB = 50.0  # issue 18: RSS growth after warm-up of a 10,000-start campaign
+
+
+def _memory_row(workers: int, n_starts: int) -> dict:
+    """RSS growth of a long TMD campaign (driver + dask workers) from the end of its warm-up (the first tenth)
+    to its end, with its SQLite store on disk as a study run has it."""
+    import tempfile
+
+    import psutil
+
+    from railopt.design import CampaignStore
+
+    def rss(client) -> tuple[float, float]:
+        workers_rss = client.run(lambda: psutil.Process().memory_info().rss)
+        return psutil.Process().memory_info().rss / 1e6, sum(workers_rss.values()) / 1e6
+
+    _, config, _ = load_study(STUDIES / "tmd_hinf.toml")
+    problem = campaign_problem(config, config.setups()["mu0.05"], "thesis")
+    warm = n_starts // 10
+    samples: dict[int, tuple[float, float]] = {}
+    with tempfile.TemporaryDirectory() as tmp, dask_client(workers=workers) as client, \
+            CampaignStore.create(Path(tmp) / "memory.sqlite", "memory", {}, problem.space.names) as store:
+        def progress(done: int, total: int) -> None:
+            if done in (warm, total) and done not in samples:
+                samples[done] = rss(client)
+
+        t = time.perf_counter()
+        table = multistart(problem, n_starts, seed=7, client=client, store=store, progress=progress)
+        elapsed = time.perf_counter() - t
+    (d0, w0), (d1, w1) = samples[warm], samples[len(table)]
+    growth = (d1 + w1) - (d0 + w0)
+    return {"benchmark": f"memory: {len(table):,}-start TMD campaign (thesis objective, {workers} dask workers, "
+                         "SQLite store on disk), RSS growth after warm-up", "ours_s": growth,
+            "reference_s": MEMORY_LIMIT_MB, "reference": f"limit {MEMORY_LIMIT_MB:.0f} MB (the columns are MB here)",
+            "ratio": growth / MEMORY_LIMIT_MB,
+            "note": f"driver {d0:.0f} → {d1:.0f} MB, workers {w0:.0f} → {w1:.0f} MB from start {warm:,} to the end; "
+                    f"{len(table) / elapsed:.0f} starts/s"}
+
+
+def _campaign_row(results: Path) -> dict:
+    """The full flagship campaign's wall time as its last ``railopt run`` recorded it (``timing.csv``)."""
+    path = results / "cab_lateral_minimax_campaign" / "timing.csv"
+    goal = 300.0
+    if not path.exists():
+        return {"benchmark": "full campaign cab_lateral_minimax_campaign.toml", "reference_s": goal,
+                "reference": "goal: 5 min on 2 cores", "note": f"not run yet: no {path}"}
+    t = pd.read_csv(path).iloc[0]
+    return {"benchmark": "full campaign cab_lateral_minimax_campaign.toml (1,542 starts, checks, trade-offs, "
+                         "surfaces), as recorded by its last run", "ours_s": float(t["total_s"]), "reference_s": goal,
+            "ratio": float(t["total_s"]) / goal, "reference": "goal: 5 min on 2 cores",
+            "note": f"compute {t['compute_s']:.0f} s + report {t['report_s']:.0f} s; {t['workers']}, "
+                    f"{t['cpus']} CPUs (railopt run studies/cab_lateral_minimax_campaign.toml)"}
+
+
 def run_bench(out: Path, workers: int = 2, quick: bool = False) -> pd.DataFrame:
     """Run every benchmark, print a table of ratios, and write it to ``out``."""
     with threadpool_limits(1):  # every timing with single-threaded BLAS, as the campaign tasks run
@@ -373,6 +427,10 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
     # 7. stability constraints with gradients; random response by quadrature vs Lyapunov ------------------------
     rows.append(_stability_row(max(repeat // 4, 5)))
     rows.append(_random_response_row(max(repeat // 4, 5)))
+
+    # 8. campaign scale: memory of a long campaign; the full flagship campaign as last run -------------------
+    rows.append(_memory_row(workers, 1000 if quick else 10_000))
+    rows.append(_campaign_row(out.parent))
 
     table = pd.DataFrame(rows, columns=["benchmark", "ours_s", "reference_s", "ratio", "reference", "note"])
     Writer(out).table(table, "bench")

@@ -16,11 +16,14 @@ one line on stderr naming the file, field or address, and exit code 2.
 from __future__ import annotations
 
 import argparse
+import os
+import platform
 import shutil
 import signal
 import sqlite3
 import sys
 import threading
+import time
 from pathlib import Path
 
 from railopt import __version__
@@ -87,6 +90,17 @@ def _terminate(signum: int, frame: object) -> None:
     raise _Terminated
 
 
+def run_timing(compute_s: float, report_s: float, context: StudyContext):
+    """One row: how long the run's compute and report took (s) and where (``timing.csv`` of every study)."""
+    import pandas as pd
+
+    where = context.scheduler or ("serial" if context.workers == 0 else
+                                  f"LocalCluster, {context.workers or os.cpu_count()} workers")
+    return pd.DataFrame([{"compute_s": compute_s, "report_s": report_s, "total_s": compute_s + report_s,
+                          "cpus": os.cpu_count(), "workers": where, "machine": platform.machine(),
+                          "python": platform.python_version()}])
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     study_file = resolve_study(args.study)
     kind, config, _ = load_study(study_file)
@@ -111,10 +125,14 @@ def cmd_run(args: argparse.Namespace) -> int:
             show_progress=not args.no_progress,
         )
         try:
+            started = time.perf_counter()
             result = kind.compute(config, context)
+            computed = time.perf_counter()
             writer = Writer(staging)
             writer.text(kind.report(result, writer), "summary.md")
             writer.copy(study_file, "study.toml")
+            reported = time.perf_counter()
+            writer.table(run_timing(computed - started, reported - computed, context), "timing")
             if not args.fresh:
                 carry_stores(final, staging)
             with writing(final):
@@ -124,6 +142,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     with_pd_options = result.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")
     print(f"\n{name}: {kind.summary}\n")
     print(with_pd_options)
+    print(f"\ncompute {computed - started:.1f} s, report {reported - computed:.1f} s")
     print(f"\nwritten to {final}/ ({', '.join(['summary.md', *writer.files])})")
     return 0
 

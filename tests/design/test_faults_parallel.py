@@ -74,8 +74,12 @@ def test_a_start_that_kills_its_worker_is_stored_as_lost_and_not_retried_unless_
         solved = table[table["status"] == "converged"]
         assert len(solved) + len(lost) == 8 and len(solved) >= 4
         np.testing.assert_allclose(solved["value"], U_STAR, atol=1e-7)  # closed form
+        # exactly the starts that crash are lost (a < 0.12, from their x0): dask also blames a death on a task
+        # queued on the dying worker, so a lost task's starts run again alone before one is stored as lost
+        assert set(lost["start_id"]) == set(table.loc[table["x0_a"] < 0.12, "start_id"])
         crashes = _crashes(log)
-        assert crashes == 2 * len(lost)  # each lost start was tried on two workers (allowed-failures = 1), no other
+        # each lost start killed two workers by itself in the run alone, and at most two before it; no other crashed
+        assert 2 * len(lost) <= crashes <= 4 * len(lost)
 
         # a resume does not try the lost starts again: no new crash, the table unchanged
         again = multistart(poisoned, client=client, store=store, **args)

@@ -174,3 +174,40 @@ def test_a_campaign_from_an_unstable_design_reports_no_unstable_best(tmp_path) -
     best = optima[optima["start_id"] == comparison["best_start"]].iloc[0]
     assert bool(best["stable"]) and best["critical_speed_rigid_m_s"] > 78.0
     assert int(comparison["failing_optima"]) == int((~optima["stable"].astype(bool)).sum())
+
+
+def test_values_first_then_the_jacobian_from_the_same_maxima(tmp_path, monkeypatch) -> None:
+    """The problem's values need no derivative (COBYLA asks for none): no Jacobian is computed for them, and the
+    values and Jacobians asked for afterwards are those of one evaluation with both, bit for bit; the Jacobian
+    matches central differences."""
+    import railopt.studies.adapter as adapter
+
+    config = load_study(STUDIES_DIR / "cab_lateral_minimax.toml")[1]
+    setup = config.setups()["sd40-2"]
+    problem = campaign_problem(config, setup, "exact")
+    x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
+    both = problem.evaluate(x, gradient=True)
+    import railopt.models.sensitivity as sensitivity
+
+    calls, maxima = [], []
+    real, real_maxima = adapter.maxima_jacobians, adapter.all_response_maxima
+    monkeypatch.setattr(adapter, "maxima_jacobians", lambda *a, **k: calls.append(1) or real(*a, **k))
+    for module in (adapter, sensitivity):
+        monkeypatch.setattr(module, "all_response_maxima", lambda *a, **k: maxima.append(1) or real_maxima(*a, **k))
+    fresh = campaign_problem(config, setup, "exact")
+    values = fresh.evaluate(x, gradient=False)
+    assert calls == [] and len(maxima) == 3  # values alone: objective and two stroke peaks, no Jacobian
+    np.testing.assert_array_equal(values.f, both.f)
+    np.testing.assert_array_equal(values.g, both.g)
+    again = fresh.evaluate(x, gradient=True)
+    assert len(calls) == 3 and len(maxima) == 3  # the Jacobians from the maxima already computed
+    np.testing.assert_array_equal(again.df, both.df)
+    np.testing.assert_array_equal(again.dg, both.dg)
+    h = 1e-6
+    for i in range(len(x)):
+        up, down = x.copy(), x.copy()
+        up[i] *= 1 + h
+        down[i] *= 1 - h
+        fd = (fresh.evaluate(up).f - fresh.evaluate(down).f) / (2 * h * x[i])
+        live = np.abs(fd) > 1e-8 * np.max(np.abs(fd))
+        np.testing.assert_allclose(both.df[live, i], fd[live], rtol=2e-4)
