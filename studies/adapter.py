@@ -196,19 +196,20 @@ class _Evaluator:
                 jacs.append(J @ dp[[rows[i] for i in moving]])
         return np.concatenate(values), np.vstack(jacs)
 
+    def _constraint_parts(self, x: np.ndarray, targets: Sequence[ResponseTarget], stability: StabilityTarget | None,
+                          jacobian: bool) -> list[np.ndarray]:
+        parts = [(self.maxima_jacobian if jacobian else self.maxima)(x, targets)] if targets else []
+        if stability is not None:
+            parts.append(self.stability(x, stability)[1 if jacobian else 0])
+        return parts
+
     def constraints(self, x: np.ndarray, targets: Sequence[ResponseTarget],
                     stability: StabilityTarget | None) -> np.ndarray:
-        parts = [self.maxima(x, targets)] if targets else []
-        if stability is not None:
-            parts.append(self.stability(x, stability)[0])
-        return np.concatenate(parts)
+        return np.concatenate(self._constraint_parts(x, targets, stability, jacobian=False))
 
     def constraints_jacobian(self, x: np.ndarray, targets: Sequence[ResponseTarget],
                              stability: StabilityTarget | None) -> np.ndarray:
-        parts = [self.maxima_jacobian(x, targets)] if targets else []
-        if stability is not None:
-            parts.append(self.stability(x, stability)[1])
-        return np.vstack(parts)
+        return np.vstack(self._constraint_parts(x, targets, stability, jacobian=True))
 
     def __getstate__(self) -> dict:  # ship to dask workers without the cached system
         return {"setup": self.setup, "names": self.names, "_key": None, "_sys": None, "_dp": None, "_pieces": {}}
