@@ -208,13 +208,19 @@ def map_unordered(
         futures = client.map(task, items, pure=False, retries=retries)
     except Exception as exc:  # e.g. the connection is gone already
         raise _lost(info, exc) from None
+    remaining = len(futures)
     item_of = {f.key: it for f, it in zip(futures, items, strict=True)}
+    # only unfinished tasks are held: a finished one's future is dropped once its result is read, so the worker
+    # frees the result (a long campaign's workers would otherwise keep every result to the end)
+    pending = {f.key: f for f in futures}
+    stream = as_completed(futures)
+    del futures
     # as_completed blocks without a timeout: it runs in a thread, and this one watches the scheduler meanwhile
     finished: queue.Queue = queue.Queue()
 
     def pump() -> None:
         try:
-            for future in as_completed(futures):
+            for future in stream:
                 finished.put(future)
         except Exception as exc:  # noqa: BLE001  (the client broke down: reported below)
             finished.put(exc)
@@ -222,7 +228,6 @@ def map_unordered(
             finished.put(None)
 
     threading.Thread(target=pump, name="railopt-as-completed", daemon=True).start()
-    remaining = len(futures)
     no_workers_since: float | None = None
     unhealthy_since: float | None = None
     try:
@@ -254,9 +259,12 @@ def map_unordered(
                 raise _lost(info, got if isinstance(got, Exception) else None)
             remaining -= 1
             no_workers_since = unhealthy_since = None
-            yield _result(got, item_of[got.key], info, on_lost)
+            key = got.key
+            result = _result(got, item_of.pop(key), info, on_lost)
+            del pending[key], got
+            yield result
     finally:
-        for future in futures:  # interrupted: do not leave work queued on a shared cluster
+        for future in pending.values():  # interrupted: do not leave work queued on a shared cluster
             if not future.done():
                 try:
                     future.cancel()
