@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -113,7 +114,7 @@ def multistart(
     points : sequence of designs, optional
         User starts (e.g. the existing suspension), ids 0.. before the sampled ones.
     client : dask.distributed.Client, optional
-        Runs one task per start; ``None`` runs serially in-process.
+        Runs the starts as dask tasks (one or a batch per task, see ``batch``); ``None`` runs serially in-process.
     store : CampaignStore, optional
         Finished starts already in it are skipped (resume); new ones are committed as they finish.
     options : dict, optional
@@ -150,7 +151,7 @@ def multistart(
         success, cluster``.
     """
     method_options(method, options)  # validates method and options before any work is done
-    if batch is not None and (isinstance(batch, bool) or not isinstance(batch, int) or batch < 1):
+    if batch is not None and (isinstance(batch, bool) or not isinstance(batch, numbers.Integral) or batch < 1):
         raise ValueError(f"batch: must be a whole number of starts per task >= 1, got {batch!r}")
     starts = start_points(problem.space, n_starts, sampler=sampler, seed=seed, points=points)
     owned = store is None
@@ -191,7 +192,7 @@ def multistart(
 
         suspects: list[Start] = []
         if client is None or batch is not None:
-            suspects = run(batches(todo, batch or 1))
+            suspects = run(batches(todo, int(batch or 1)))
         else:  # one start per worker first: how long a start takes decides the batch
             workers = _workers(client)
             probe, rest = todo[:workers], todo[workers:]

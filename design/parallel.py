@@ -479,10 +479,14 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     # how long the embedded cluster may be without workers (its nannies restart crashed ones) before giving up
     wait = LOCAL_NO_WORKERS_LIMIT
     # A start that kills its worker is tried twice, not four times, before it is reported as lost; each worker
-    # holds one task at a time (worker-saturation 1), so a death is held against the task that caused it only.
+    # holds one task at a time (worker-saturation 1), though dask still blames a death on a task queued on the dying
+    # worker after a restart (multistart re-runs a lost task's starts alone for that).  The cluster never gives up a
+    # crashed worker for good: dask closes a nanny whose worker is still restarting 15 s after a crash
+    # (lost-worker-timeout), which a run of crashing starts hits; our own limit is LOCAL_NO_WORKERS_LIMIT.
     with (
         _quiet_dask_logs(),
         dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0,
+                         "distributed.deploy.lost-worker-timeout": "1000 days",
                          # a worker's own threads take the GIL from the solving thread: its sampling profiler
                          # (every 10 ms), the event-loop tick (20 ms), memory (100 ms) and system (500 ms) monitors
                          "distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "200ms",

@@ -1,7 +1,8 @@
 """The campaign store: one SQLite file per campaign, a versioned schema, a reader returning DataFrames.
 
 Every finished start is committed in its own transaction as it streams back, so a killed
-campaign loses at most the starts that were running; ``--resume`` skips the finished ones.
+campaign loses at most the starts of the tasks that were running (a task holds one start, or a batch of
+up to 8 short ones); ``--resume`` skips the finished ones.
 ``start_id`` is the primary key: a start can never be stored twice.  No pickles: vectors are
 JSON, and the campaign config is stored with its SHA-256 so that a resume with a different
 config is refused.

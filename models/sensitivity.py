@@ -100,6 +100,12 @@ def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tupl
     names = list(system.output_names if outputs is None else outputs)
     if maxima is None or any(n not in maxima for n in names):
         maxima = all_response_maxima(system, band_rad_s=(lo, hi), exact=exact, outputs=names)
+    else:
+        for name in names:
+            rm = maxima[name]
+            if bool(rm.exact) != bool(exact) or tuple(rm.band) != (lo, hi):
+                raise ValueError(f"maxima: {name!r} was computed with exact={rm.exact} over {tuple(rm.band)} rad/s, "
+                                 f"not exact={exact} over {(lo, hi)}")
     n, P = system.n, len(t.parameters)
     dwd = damped_frequency_jacobian(system)
     wd = system.damped_frequencies()

@@ -305,6 +305,11 @@ def _campaign_row(results: Path) -> dict:
         return {"benchmark": "full campaign cab_lateral_minimax_campaign.toml", "reference_s": goal,
                 "reference": "goal: 5 min on 2 cores", "note": f"not run yet: no {path}"}
     t = pd.read_csv(path).iloc[0]
+    if bool(t.get("resumed", False)):
+        return {"benchmark": "full campaign cab_lateral_minimax_campaign.toml", "reference_s": goal,
+                "reference": "goal: 5 min on 2 cores",
+                "note": f"its last run resumed stored starts ({path}): not a timing of the whole campaign; run it "
+                        "with --fresh"}
     starts = path.with_name("starts.csv")
     count = f"{len(pd.read_csv(starts)):,} starts" if starts.exists() else "its starts"
     return {"benchmark": f"full campaign cab_lateral_minimax_campaign.toml ({count}, checks, trade-offs, "

@@ -91,14 +91,14 @@ def _terminate(signum: int, frame: object) -> None:
 
 
 def run_timing(compute_s: float, report_s: float, context: StudyContext):
-    """One row: how long the run's compute and report took (s) and where (``timing.csv`` of every study)."""
+    """One row: how long the run's compute and report took (s), whether it resumed stored work, and where it ran
+    (``timing.csv`` of every study)."""
     import pandas as pd
 
-    where = context.scheduler or ("serial" if context.workers == 0 else
-                                  f"LocalCluster, {context.workers or os.cpu_count()} workers")
+    where = "; ".join(context.executed_on) or "serial"  # what the run really used (kinds without dask: serial)
     return pd.DataFrame([{"compute_s": compute_s, "report_s": report_s, "total_s": compute_s + report_s,
-                          "cpus": os.cpu_count(), "workers": where, "machine": platform.machine(),
-                          "python": platform.python_version()}])
+                          "resumed": bool(context.resume), "cpus": os.cpu_count(), "workers": where,
+                          "machine": platform.machine(), "python": platform.python_version()}])
 
 
 def cmd_run(args: argparse.Namespace) -> int:

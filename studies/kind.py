@@ -16,7 +16,8 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from collections.abc import Callable
-from dataclasses import dataclass
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -40,6 +41,7 @@ class StudyContext:
     resume: bool = False
     retry_failed: bool = False  # --resume also re-runs the starts stored as worker_lost
     show_progress: bool = True
+    executed_on: list[str] = field(default_factory=list)  # what dask_context opened: "serial", a cluster, an address
 
 
 class StudyResult(Protocol):
@@ -85,4 +87,24 @@ def dask_context(context: StudyContext):
     """The dask client for a study run (``None`` = serial when ``workers == 0``)."""
     from railopt.design.parallel import dask_client
 
-    return dask_client(context.workers, context.scheduler, timeout=context.scheduler_timeout)
+    @contextmanager
+    def recorded():
+        with dask_client(context.workers, context.scheduler, timeout=context.scheduler_timeout) as client:
+            where = "serial" if client is None else _where(client)
+            if where not in context.executed_on:
+                context.executed_on.append(where)
+            yield client
+
+    return recorded()
+
+
+def _where(client) -> str:
+    """A client's cluster in words: the embedded LocalCluster and its workers, or the scheduler's address."""
+    try:
+        n = len(client.scheduler_info().get("workers", {}))
+    except Exception:  # noqa: BLE001  (only a label)
+        n = None
+    cluster = getattr(client, "cluster", None)
+    if cluster is not None and type(cluster).__name__ == "LocalCluster":
+        return f"LocalCluster, {n} workers"
+    return f"scheduler {client.scheduler.address}" + (f", {n} workers" if n is not None else "")

@@ -121,11 +121,41 @@ def test_a_batch_with_a_crashing_start_loses_only_that_start(tmp_path: Path) -> 
     np.testing.assert_allclose(kept["value"], U_STAR, atol=1e-7)  # closed form
 
 
+@dataclass(frozen=True)
+class Storm:
+    """Crashes its process for a < 0.4 and b > 0.5 (about one start in five)."""
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        if x[0] < 0.4 and x[1] > 0.5:
+            os._exit(1)
+        return _f(x)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(300)
+def test_many_crashing_starts_do_not_exhaust_the_cluster() -> None:
+    """A dozen crashing starts (each kills up to four workers): dask would close a nanny whose worker is still
+    restarting 15 s after a crash and leave the cluster without workers; the embedded cluster never gives one up,
+    so the campaign ends with exactly the crashing starts lost and every other row the serial one."""
+    args = {"n_starts": 59, "method": "slsqp", "seed": 5, "points": [[0.1, 0.9]]}
+    serial = multistart(MinimaxProblem(VARIABLES, _f), **args)
+    crashing = set(serial.loc[(serial["x0_a"] < 0.4) & (serial["x0_b"] > 0.5), "start_id"])
+    assert len(crashing) >= 9
+    with dask_client(workers=2) as client:
+        table = multistart(MinimaxProblem(VARIABLES, Storm()), client=client, **args)
+    assert set(table.loc[table["status"] == "worker_lost", "start_id"]) == crashing
+    kept = table[~table["start_id"].isin(crashing)].reset_index(drop=True)
+    ref = serial[~serial["start_id"].isin(crashing)].reset_index(drop=True)
+    for col in ("start_id", "a", "b", "value", "evaluations", "status"):
+        np.testing.assert_array_equal(kept[col], ref[col])
+
+
 def test_batch_must_be_a_positive_whole_number() -> None:
     problem = MinimaxProblem(VARIABLES, _f)
     for bad in (0, -2, 1.5, True, "4"):
         with pytest.raises(ValueError, match="batch"):
             multistart(problem, 4, batch=bad)
+    assert len(multistart(problem, 4, batch=np.int64(2))) == 4  # numpy integers are whole numbers
 
 
 # ---------------------------------------------------------------------- unpicklable problems

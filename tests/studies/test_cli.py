@@ -153,3 +153,17 @@ def test_scheduler_address_runs_the_campaign_on_an_existing_cluster(tmp_path, mo
     ref = pd.read_csv(serial / "tmd_hinf" / "starts.csv")[cols]
     for root in (on_cluster, via_env):
         pd.testing.assert_frame_equal(pd.read_csv(root / "tmd_hinf" / "starts.csv")[cols], ref)
+
+
+def test_timing_says_where_the_run_ran(tmp_path: Path) -> None:
+    """``timing.csv``: a kind that opens no dask client ran serially, whatever --workers says; ``--workers 0``
+    is serial too; a fresh run is not a resumed one."""
+    assert main(["run", str(STUDIES_DIR / "tmd_frf.toml"), "--results", str(tmp_path), "--fresh", "--no-progress"]) == 0
+    frf = pd.read_csv(tmp_path / "tmd_frf" / "timing.csv").iloc[0]
+    assert frf["workers"] == "serial" and not frf["resumed"] and frf["total_s"] >= frf["compute_s"] > 0
+    assert main(["run", str(STUDIES_DIR / "tmd_hinf.toml"), "--results", str(tmp_path), "--fresh", "--workers", "0",
+                 "--no-progress"]) == 0
+    assert pd.read_csv(tmp_path / "tmd_hinf" / "timing.csv").iloc[0]["workers"] == "serial"
+    assert main(["run", str(STUDIES_DIR / "tmd_hinf.toml"), "--results", str(tmp_path), "--resume", "--workers", "0",
+                 "--no-progress"]) == 0
+    assert bool(pd.read_csv(tmp_path / "tmd_hinf" / "timing.csv").iloc[0]["resumed"])

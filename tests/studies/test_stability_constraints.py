@@ -211,3 +211,22 @@ def test_values_first_then_the_jacobian_from_the_same_maxima(tmp_path, monkeypat
         fd = (fresh.evaluate(up).f - fresh.evaluate(down).f) / (2 * h * x[i])
         live = np.abs(fd) > 1e-8 * np.max(np.abs(fd))
         np.testing.assert_allclose(both.df[live, i], fd[live], rtol=2e-4)
+
+
+def test_maxima_of_another_band_or_method_are_refused() -> None:
+    """``maxima_jacobians(..., maxima=...)`` reuses maxima only of the same band and method (else ValueError)."""
+    from railopt.models.response_maxima import all_response_maxima
+    from railopt.models.sensitivity import maxima_jacobians
+
+    config = load_study(STUDIES_DIR / "cab_lateral_minimax.toml")[1]
+    setup = config.setups()["sd40-2"]
+    sys_ = setup.family.at(setup.family.values)
+    band = (0.1, 18.0)
+    thesis = all_response_maxima(sys_, band_rad_s=band, outputs=["cab_acceleration"])
+    with pytest.raises(ValueError, match="maxima"):
+        maxima_jacobians(sys_, band_rad_s=band, exact=True, outputs=["cab_acceleration"], maxima=thesis)
+    with pytest.raises(ValueError, match="maxima"):
+        maxima_jacobians(sys_, band_rad_s=(0.1, 9.0), outputs=["cab_acceleration"], maxima=thesis)
+    reused = maxima_jacobians(sys_, band_rad_s=band, outputs=["cab_acceleration"], maxima=thesis)
+    fresh = maxima_jacobians(sys_, band_rad_s=band, outputs=["cab_acceleration"])
+    np.testing.assert_array_equal(reused["cab_acceleration"][1], fresh["cab_acceleration"][1])
