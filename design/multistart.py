@@ -20,21 +20,9 @@ from railopt.design.store import CampaignStore
 
 
 @dataclass(frozen=True)
-class _StartTask:
-    """One start, shipped to a worker (NLopt objects are built there, inside :func:`solve`)."""
-
-    problem: MinimaxProblem
-    start: Start
-    method: str
-    options: dict[str, Any]
-
-    def __call__(self) -> tuple[Start, SolveResult]:
-        return self.start, solve(self.problem, self.start.x0, method=self.method, **self.options)
-
-
-@dataclass(frozen=True)
 class _StartBatch:
-    """Several starts in one task, solved one after the other (short starts: dask's per-task cost amortised)."""
+    """Starts shipped to a worker as one task (NLopt objects are built there, inside :func:`solve`), solved one
+    after the other: one start, or several short ones (dask's per-task cost amortised)."""
 
     problem: MinimaxProblem
     starts: tuple[Start, ...]
@@ -63,7 +51,7 @@ def batch_size(n_todo: int, workers: int, start_seconds: float) -> int:
     return int(max(1, min(MAX_BATCH, enough, balanced)))
 
 
-def _workers(client: Any) -> int:
+def _worker_threads(client: Any) -> int:
     try:
         return max(sum(client.nthreads().values()), 1)
     except Exception:  # noqa: BLE001  (a scheduler that does not answer: one start per task, as before)
@@ -74,14 +62,17 @@ def _lost_batch(task: _StartBatch, lost: WorkerLost) -> _LostBatch:
     return _LostBatch(task.starts)
 
 
-def _lost_start(task: _StartTask, lost: WorkerLost) -> tuple[Start, SolveResult]:
-    """The row of a start whose task killed every worker it ran on: x = x0, U = inf, status ``worker_lost``."""
-    x0 = np.asarray(task.start.x0, dtype=float)
-    return task.start, SolveResult(
-        x=x0, value=np.inf, t=np.inf, status="worker_lost",
-        message=f"worker lost: {lost}; not retried on --resume unless asked (retry_failed)",
-        evaluations=0, wall_time=0.0, method=task.method, x0=x0, constraint_violation=0.0, bound_violation=0.0,
-    )
+def _lost_starts(task: _StartBatch, lost: WorkerLost) -> list[tuple[Start, SolveResult]]:
+    """The rows of starts whose task killed every worker it ran on: x = x0, U = inf, status ``worker_lost``."""
+    rows = []
+    for start in task.starts:
+        x0 = np.asarray(start.x0, dtype=float)
+        rows.append((start, SolveResult(
+            x=x0, value=np.inf, t=np.inf, status="worker_lost",
+            message=f"worker lost: {lost}; not retried on --resume unless asked (retry_failed)",
+            evaluations=0, wall_time=0.0, method=task.method, x0=x0, constraint_violation=0.0, bound_violation=0.0,
+        )))
+    return rows
 
 
 def multistart(
@@ -175,10 +166,11 @@ def multistart(
             if progress is not None:
                 progress(done, total)
 
-        def run(tasks: list[_StartBatch]) -> list[Start]:
-            """Record every start of ``tasks``; return the starts of the tasks that were lost."""
+        def run(tasks: list[_StartBatch], on_lost: Callable = _lost_batch) -> list[Start]:
+            """Record every start of ``tasks``; return the starts of the tasks that were lost (``on_lost`` may
+            instead give their rows, which are recorded)."""
             lost: list[Start] = []
-            for out in map_unordered(call, tasks, client=client, on_lost=_lost_batch):
+            for out in map_unordered(call, tasks, client=client, on_lost=on_lost):
                 if isinstance(out, _LostBatch):
                     lost.extend(out.starts)
                     continue
@@ -190,11 +182,10 @@ def multistart(
             return [_StartBatch(problem, tuple(starts[i:i + size]), method, user_options)
                     for i in range(0, len(starts), size)]
 
-        suspects: list[Start] = []
         if client is None or batch is not None:
             suspects = run(batches(todo, int(batch or 1)))
         else:  # one start per worker first: how long a start takes decides the batch
-            workers = _workers(client)
+            workers = _worker_threads(client)
             probe, rest = todo[:workers], todo[workers:]
             suspects = run(batches(probe, 1))
             size = batch_size(len(rest), workers, float(np.median(seconds)) if seconds else 0.0)
@@ -202,9 +193,7 @@ def multistart(
         # A lost task's starts run again one at a time, each alone on the cluster: dask also holds a worker's death
         # against a task queued there, so only a start that kills two workers by itself is stored as lost.
         for start in suspects:
-            for start_, result in map_unordered(call, [_StartTask(problem, start, method, user_options)],
-                                                client=client, on_lost=_lost_start):
-                record(start_, result)
+            run(batches([start], 1), on_lost=_lost_starts)
         table = store.starts()
     finally:
         if owned:
