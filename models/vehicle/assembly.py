@@ -61,8 +61,8 @@ class SuspensionMatrices:
         """``base + Σ p_i W_i`` over the parameters of ``kind`` (``"K"`` or ``"C"``) not in ``skip``, with
         ``W_i`` from ``stacks`` (parameter id -> matrix) or else the parameter's own weight matrix."""
         ids = [k for k, (kd, _) in self.parts.items() if kd == kind and k not in skip]
-        weights = self.parts if stacks is None else {k: (kind, stacks[k]) for k in ids}
-        stack = np.array([weights[k][1] for k in ids]).reshape(len(ids), *base.shape)
+        mats = [self.parts[k][1] if stacks is None else stacks[k] for k in ids]
+        stack = np.array(mats).reshape(len(ids), *base.shape)
         return affine(base, stack, np.array([self.values[k] for k in ids]))
 
 
