@@ -469,6 +469,56 @@ def _wrt_jacobian(system: LinearSystem, wrt: Sequence[int] | None) -> np.ndarray
     return eigenvalue_derivatives(system, t.dM[idx], t.dC[idx], t.dK[idx])
 
 
+class StabilityRows:
+    """The stability constraint rows of one design: the members solved once, values now, derivatives when asked.
+
+    ``StabilityRows(family, p, speeds, exclude)`` solves the member at every speed S_k once (one eigen-
+    decomposition each) and keeps its roots one per mode (mode order) with the kept-mode mask (see
+    :func:`root_constraints`).  A derivative-free optimiser reads :meth:`roots` / :meth:`damping` only; a
+    gradient method then asks :meth:`roots_jacobian` / :meth:`damping_jacobian`, which reuse the same
+    decompositions (the root derivatives ds/dp, thesis eqs. (4.53)–(4.58) with the left eigenvectors, are
+    computed once per speed and shared by both kinds of row).
+    """
+
+    def __init__(self, family, p: Sequence[float] | None, speeds: Sequence[float], exclude: Sequence[str] = ()) -> None:
+        self._members = [(system, idx, keep) for _, system, idx, keep in _family_rows(family, p, speeds, exclude)]
+        self._ds: dict[tuple[int, ...] | None, list[np.ndarray]] = {}
+
+    def _root_derivatives(self, wrt: Sequence[int] | None) -> list[np.ndarray]:
+        key = None if wrt is None else tuple(int(i) for i in wrt)
+        if key not in self._ds:
+            self._ds[key] = [_wrt_jacobian(system, wrt)[idx] for system, idx, _ in self._members]
+        return self._ds[key]
+
+    def roots(self, sigma_min: float = 0.0) -> np.ndarray:
+        """``g = Re s_j + σ_min`` (K·n,), 1/s; −1 for a dropped mode."""
+        sigma_min = number("sigma_min", sigma_min, non_negative=True)
+        return np.concatenate([np.where(keep, system.modal().s[idx].real + sigma_min, -1.0)
+                               for system, idx, keep in self._members])
+
+    def roots_jacobian(self, wrt: Sequence[int] | None = None) -> np.ndarray:
+        """``dg/dp`` of :meth:`roots` (K·n, len(wrt)); zero rows for dropped modes."""
+        return np.vstack([np.where(keep[:, None], ds.real, 0.0)
+                          for (_, _, keep), ds in zip(self._members, self._root_derivatives(wrt), strict=True)])
+
+    def damping(self, zeta_min: float) -> np.ndarray:
+        """``g = ζ_min − ζ_j`` (K·n,) with ζ = −Re s/|s|; −1 for a dropped mode."""
+        zeta_min = number("zeta_min", zeta_min)
+        values = []
+        for system, idx, keep in self._members:
+            s = system.modal().s[idx]
+            values.append(np.where(keep, zeta_min + s.real / np.abs(s), -1.0))
+        return np.concatenate(values)
+
+    def damping_jacobian(self, wrt: Sequence[int] | None = None) -> np.ndarray:
+        """``dg/dp`` of :meth:`damping` (K·n, len(wrt)) from dζ/dp = damping_ratio_jacobian(s, ds/dp)."""
+        jac = []
+        for (system, idx, keep), ds in zip(self._members, self._root_derivatives(wrt), strict=True):
+            dzeta = damping_ratio_jacobian(system.modal().s[idx], ds)
+            jac.append(np.where(keep[:, None], -dzeta, 0.0))
+        return np.vstack(jac)
+
+
 def root_constraints(family, p: Sequence[float] | None, speeds: Sequence[float], sigma_min: float = 0.0,
                      exclude: Sequence[str] = (), wrt: Sequence[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Stability constraint rows ``g = Re s_j(p, S_k) + σ_min ≤ 0`` for every mode j at every speed S_k (SPEC §2.5).
@@ -478,15 +528,11 @@ def root_constraints(family, p: Sequence[float] | None, speeds: Sequence[float],
     or a name prefix) gets the constant row −1 with a zero gradient.  Returns ``(g (K·n,), dg/dp (K·n, P))``,
     1/s.  ``family`` is a ParametricSystem with a speed term; ``p`` its parameters (None: its values);
     ``wrt`` the indices of the parameters to differentiate (default all; the Jacobian has one column each).
+    Values alone, or values now and derivatives later: :class:`StabilityRows`.
     """
     sigma_min = number("sigma_min", sigma_min, non_negative=True)
-    values, jac = [], []
-    for _, system, idx, keep in _family_rows(family, p, speeds, exclude):
-        ds = _wrt_jacobian(system, wrt)[idx]
-        s = system.modal().s[idx]
-        values.append(np.where(keep, s.real + sigma_min, -1.0))
-        jac.append(np.where(keep[:, None], ds.real, 0.0))
-    return np.concatenate(values), np.vstack(jac)
+    rows = StabilityRows(family, p, speeds, exclude)
+    return rows.roots(sigma_min), rows.roots_jacobian(wrt)
 
 
 def damping_constraints(family, p: Sequence[float] | None, speeds: Sequence[float], zeta_min: float,
@@ -497,13 +543,8 @@ def damping_constraints(family, p: Sequence[float] | None, speeds: Sequence[floa
     dζ/dp from the root derivatives.  Returns ``(g (K·n,), dg/dp (K·n, P))``.
     """
     zeta_min = number("zeta_min", zeta_min)
-    values, jac = [], []
-    for _, system, idx, keep in _family_rows(family, p, speeds, exclude):
-        s = system.modal().s[idx]
-        dzeta = damping_ratio_jacobian(s, _wrt_jacobian(system, wrt)[idx])
-        values.append(np.where(keep, zeta_min + s.real / np.abs(s), -1.0))
-        jac.append(np.where(keep[:, None], -dzeta, 0.0))
-    return np.concatenate(values), np.vstack(jac)
+    rows = StabilityRows(family, p, speeds, exclude)
+    return rows.damping(zeta_min), rows.damping_jacobian(wrt)
 
 
 def critical_speed_gradient(family, p: Sequence[float] | None = None, speed_range: tuple[float, float] = (1.0, 100.0),

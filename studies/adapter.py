@@ -5,8 +5,9 @@ the f_k of other outputs held below a limit (ε-constraint trade-offs, g(x) ≤ 
 of SPEC §2.5 (:class:`StabilityTarget`: Re s_j + σ_min ≤ 0 for every vehicle mode at a grid of speeds up to
 the required speed, on each track's stability family; optionally ζ_j ≥ ζ_min).  Gradients are analytic:
 ``df/dx = df/dp · dp/dx`` (model Jacobian, then the parameter map of the setup); the stability rows from
-the eigenvalue sensitivities (:func:`railopt.models.stability.root_constraints`).  The objective and the
-response constraints at one x share one system and one eigen-decomposition.
+the eigenvalue sensitivities (:class:`railopt.models.stability.StabilityRows`: the members solved once, the
+derivatives only when the method asks).  The objective and the response constraints at one x share one
+system and one eigen-decomposition.
 
 A ride objective (:class:`RMSTarget`) is the RMS of one output per metre of rail irregularity under a track
 spectrum at the family's speed over a band (:func:`railopt.models.random_response.random_response`, adaptive
@@ -28,7 +29,7 @@ from railopt.models import LinearSystem
 from railopt.models.random_response import random_response
 from railopt.models.response_maxima import all_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
-from railopt.models.stability import damping_constraints, root_constraints
+from railopt.models.stability import StabilityRows
 from railopt.studies.catalog import ModelSetup
 
 __all__ = ["RMSTarget", "ResponseTarget", "StabilityTarget", "minimax_problem", "rms_gradient"]
@@ -172,35 +173,52 @@ class _Evaluator:
             return target.scale * rms_gradient(sys, self._rms(x, target), dp)[None, :]
         return self.maxima_jacobian(x, [target])
 
-    def stability(self, x: np.ndarray, target: StabilityTarget) -> tuple[np.ndarray, np.ndarray]:
-        """The rows of ``target`` at x and their Jacobian in x (computed together: the roots' derivatives
-        cost little beside the eigen-solves they share)."""
-        return self._piece(x, ("stability", id(target)), lambda: self._stability(x, target))
+    def _stability_rows(self, x: np.ndarray,
+                        target: StabilityTarget) -> list[tuple[StabilityRows, list[int], list[int]]]:
+        """Per track: the solved members (:class:`StabilityRows`), the designed parameters' indices in the track
+        family and in the design family."""
+        def compute():
+            _, dp = self.system(x)
+            p, _ = self.setup.parameters(self.names, np.asarray(x, dtype=float))
+            params = list(self.setup.family.parameters)
+            out = []
+            for track in target.tracks:
+                family = self.setup.stability[track]
+                rows = [params.index(n) for n in family.parameters]
+                moving = [i for i, r in enumerate(rows) if np.any(dp[r] != 0.0)]  # only designed parameters
+                out.append((StabilityRows(family, p[rows], target.speeds, target.exclude), moving,
+                            [rows[i] for i in moving]))
+            return out
 
-    def _stability(self, x: np.ndarray, target: StabilityTarget) -> tuple[np.ndarray, np.ndarray]:
+        return self._piece(x, ("stability rows", id(target)), compute)
+
+    def stability(self, x: np.ndarray, target: StabilityTarget) -> np.ndarray:
+        """The rows of ``target`` at x: for each track, Re s + σ_min, then ζ_min − ζ when ζ_min is set."""
+        def compute():
+            values = []
+            for rows, _, _ in self._stability_rows(x, target):
+                values.append(rows.roots(target.sigma_min))
+                if target.zeta_min is not None:
+                    values.append(rows.damping(target.zeta_min))
+            return np.concatenate(values)
+
+        return self._piece(x, ("stability", id(target)), compute)
+
+    def stability_jacobian(self, x: np.ndarray, target: StabilityTarget) -> np.ndarray:
+        """d(rows)/dx, from the members solved for :meth:`stability` (a derivative-free method never pays it)."""
         _, dp = self.system(x)
-        p, _ = self.setup.parameters(self.names, np.asarray(x, dtype=float))
-        params = list(self.setup.family.parameters)
-        values, jacs = [], []
-        for track in target.tracks:
-            family = self.setup.stability[track]
-            rows = [params.index(n) for n in family.parameters]
-            moving = [i for i, r in enumerate(rows) if np.any(dp[r] != 0.0)]  # only designed parameters
-            p_fam = p[rows]
-            g, J = root_constraints(family, p_fam, target.speeds, target.sigma_min, target.exclude, wrt=moving)
-            values.append(g)
-            jacs.append(J @ dp[[rows[i] for i in moving]])
+        jacs = []
+        for rows, moving, design_rows in self._stability_rows(x, target):
+            jacs.append(rows.roots_jacobian(moving) @ dp[design_rows])
             if target.zeta_min is not None:
-                g, J = damping_constraints(family, p_fam, target.speeds, target.zeta_min, target.exclude, wrt=moving)
-                values.append(g)
-                jacs.append(J @ dp[[rows[i] for i in moving]])
-        return np.concatenate(values), np.vstack(jacs)
+                jacs.append(rows.damping_jacobian(moving) @ dp[design_rows])
+        return np.vstack(jacs)
 
     def _constraint_parts(self, x: np.ndarray, targets: Sequence[ResponseTarget], stability: StabilityTarget | None,
                           jacobian: bool) -> list[np.ndarray]:
         parts = [(self.maxima_jacobian if jacobian else self.maxima)(x, targets)] if targets else []
         if stability is not None:
-            parts.append(self.stability(x, stability)[1 if jacobian else 0])
+            parts.append((self.stability_jacobian if jacobian else self.stability)(x, stability))
         return parts
 
     def constraints(self, x: np.ndarray, targets: Sequence[ResponseTarget],

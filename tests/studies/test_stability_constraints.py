@@ -176,7 +176,7 @@ def test_a_campaign_from_an_unstable_design_reports_no_unstable_best(tmp_path) -
     assert int(comparison["failing_optima"]) == int((~optima["stable"].astype(bool)).sum())
 
 
-def test_values_first_then_the_jacobian_from_the_same_maxima(tmp_path, monkeypatch) -> None:
+def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_path, monkeypatch) -> None:
     """The problem's values need no derivative (COBYLA asks for none): no Jacobian is computed for them, and the
     values and Jacobians asked for afterwards are those of one evaluation with both, bit for bit; the Jacobian
     matches central differences."""
@@ -188,22 +188,31 @@ def test_values_first_then_the_jacobian_from_the_same_maxima(tmp_path, monkeypat
     x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
     both = problem.evaluate(x, gradient=True)
     import railopt.models.sensitivity as sensitivity
+    import railopt.models.stability as stability
 
-    calls, maxima = [], []
+    calls, maxima, roots, members = [], [], [], []
     real, real_maxima = adapter.maxima_jacobians, adapter.all_response_maxima
+    real_roots, real_members = stability.eigenvalue_derivatives, stability._family_rows
     monkeypatch.setattr(adapter, "maxima_jacobians", lambda *a, **k: calls.append(1) or real(*a, **k))
     for module in (adapter, sensitivity):
         monkeypatch.setattr(module, "all_response_maxima", lambda *a, **k: maxima.append(1) or real_maxima(*a, **k))
+    monkeypatch.setattr(stability, "eigenvalue_derivatives", lambda *a, **k: roots.append(1) or real_roots(*a, **k))
+    monkeypatch.setattr(stability, "_family_rows", lambda *a, **k: members.append(1) or real_members(*a, **k))
     fresh = campaign_problem(config, setup, "exact")
+    tracks = len(config.stability.target(setup).tracks)
+    speeds = len(config.stability.target(setup).speeds)
     values = fresh.evaluate(x, gradient=False)
-    assert calls == [] and len(maxima) == 3  # values alone: objective and two stroke peaks, no Jacobian
+    # values alone: objective and two stroke peaks, the stability members solved once per track, no derivative
+    assert calls == [] and len(maxima) == 3 and roots == [] and len(members) == tracks
     np.testing.assert_array_equal(values.f, both.f)
     np.testing.assert_array_equal(values.g, both.g)
     again = fresh.evaluate(x, gradient=True)
-    assert len(calls) == 3 and len(maxima) == 3  # the Jacobians from the maxima already computed
+    # the Jacobians from the maxima and the members already solved: root derivatives once per speed and track
+    assert len(calls) == 3 and len(maxima) == 3 and len(members) == tracks and len(roots) == tracks * speeds
     np.testing.assert_array_equal(again.df, both.df)
     np.testing.assert_array_equal(again.dg, both.dg)
     h = 1e-6
+    row_scale = np.maximum(np.abs(both.g), np.max(np.abs(both.dg * x), axis=1))
     for i in range(len(x)):
         up, down = x.copy(), x.copy()
         up[i] *= 1 + h
@@ -211,6 +220,10 @@ def test_values_first_then_the_jacobian_from_the_same_maxima(tmp_path, monkeypat
         fd = (fresh.evaluate(up).f - fresh.evaluate(down).f) / (2 * h * x[i])
         live = np.abs(fd) > 1e-8 * np.max(np.abs(fd))
         np.testing.assert_allclose(both.df[live, i], fd[live], rtol=2e-4)
+        # strokes and stability rows, as relative sensitivities x_i dg/dx_i; each row to 1e-6 of its own scale
+        fd_g = (fresh.evaluate(up).g - fresh.evaluate(down).g) / (2 * h)
+        err = np.abs(both.dg[:, i] * x[i] - fd_g)
+        assert np.all(err <= 2e-4 * np.abs(fd_g) + 1e-6 * row_scale), (i, np.max(err / row_scale))
 
 
 def test_maxima_of_another_band_or_method_are_refused() -> None:
