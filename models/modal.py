@@ -10,6 +10,7 @@ rely on an ordering: they use :func:`railopt.models.stability.spectral_abscissa`
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -24,26 +25,43 @@ CONDITION_LIMIT = 1e8  # cond₁(V) above which the pole–residue form is not u
 class Modal(ArrayRecord):
     """Eigen-decomposition of the state matrix G (4.53): roots s (2n,), right eigenvectors V
     (columns) and left ones W = V⁻¹ (rows, so W V = I); ``condition`` = ‖V‖₁‖W‖₁ (inf when V
-    is singular)."""
+    is singular).
+
+    W and the condition are worked out when first read (one solve ``V W = I``): the roots and their
+    mode shapes (stability rows, root loci) never pay for them; derivatives and the pole–residue form do.
+    """
 
     s: np.ndarray
     V: np.ndarray
-    W: np.ndarray
-    condition: float
+
+    @cached_property
+    def _left(self) -> tuple[np.ndarray, float]:
+        try:
+            W = np.linalg.solve(self.V, np.eye(self.V.shape[0]))
+            condition = float(np.linalg.norm(self.V, 1) * np.linalg.norm(W, 1))
+        except np.linalg.LinAlgError:
+            W = np.full_like(self.V, np.nan)
+            condition = float("inf")
+        if not np.isfinite(condition):
+            condition = float("inf")
+        W.setflags(write=False)
+        return W, condition
+
+    @property
+    def W(self) -> np.ndarray:
+        """Left eigenvectors (2n, 2n), rows, W = V⁻¹ (NaN when V is singular)."""
+        return self._left[0]
+
+    @property
+    def condition(self) -> float:
+        """cond₁(V) = ‖V‖₁‖W‖₁ (inf when V is singular)."""
+        return self._left[1]
 
 
 def modal(G: np.ndarray) -> Modal:
-    """Right and left eigenvectors of G with the normalisation W V = I."""
+    """Roots and right eigenvectors of G; the left ones (normalised W V = I) when first read."""
     s, V = np.linalg.eig(G)
-    try:
-        W = np.linalg.solve(V, np.eye(V.shape[0]))
-        condition = float(np.linalg.norm(V, 1) * np.linalg.norm(W, 1))
-    except np.linalg.LinAlgError:
-        W = np.full_like(V, np.nan)
-        condition = float("inf")
-    if not np.isfinite(condition):
-        condition = float("inf")
-    return Modal(s, V, W, condition)
+    return Modal(s, V)
 
 
 def mode_order(s: np.ndarray) -> np.ndarray:

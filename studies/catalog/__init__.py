@@ -118,6 +118,12 @@ class HuntingCheck:
         return CheckResult(speed, {"stable": bool(speed > self.max_speed and min(damping) > 0)}, data)
 
 
+UNITS = {"stiffness": "N/m", "damping coefficient": "N·s/m", "rotational stiffness": "N·m/rad",
+         "rotational damping coefficient": "N·m·s/rad", "mass": "kg", "moment of inertia": "kg·m²",
+         "frequency ratio": "–", "damping ratio": "–"}
+"""The SI unit of a parameter by what it is (the kinds of :attr:`ParameterMap.limits`); "–": dimensionless."""
+
+
 @dataclass(frozen=True)
 class ParameterMap:
     """Design variables → the family's parameter vector.
@@ -140,6 +146,12 @@ class ParameterMap:
     def designable(self) -> tuple[str, ...]:
         """Names a study may use as design variables."""
         return self.parameters + self.derived + tuple(a for a, k in self.aliases.items() if k in self.parameters)
+
+    def unit(self, name: str) -> str:
+        """The SI unit of a design variable (id, alias or derived) from what it is (:data:`UNITS`); "" when
+        unknown."""
+        limit = self.lower_limit(name)
+        return UNITS.get(limit[1], "") if limit else ""
 
     def lower_limit(self, name: str) -> tuple[float, str] | None:
         """(least physical value, what the parameter is) of a design variable (id, alias or derived), or None

@@ -414,12 +414,17 @@ BOUNDARY_STYLES = (("k", "--"), ("C1", ":"), ("C2", "-."), ("C4", "--"))
 MARK_STYLES = (("r", "*", 13), ("w", "X", 9), ("C1", "P", 9))
 
 
-def plot_surfaces(constrained, unconstrained, title: str, boundaries=(), marks=None) -> Figure:
+def plot_surfaces(constrained, unconstrained, title: str, boundaries=(), marks=None,
+                  units: tuple[str, str, str] = ("", "", "")) -> Figure:
     """Fig 4.18: U over two variables as 3-D surfaces and contours, constrained and unconstrained.
 
     ``boundaries`` (label, values on the constrained grid, limit, at_least) are drawn as contours ``values = limit``
     on the constrained contour panel, the infeasible side hatched; ``marks`` (label -> design values) are marked on
-    both contour panels (e.g. the recommended design and the unconstrained optimum)."""
+    both contour panels (e.g. the recommended design and the unconstrained optimum).  ``units`` of the two
+    variables and of U: the axes read ``log10 <name> (<unit>)``, the value in that unit."""
+    def log_label(name: str, unit: str) -> str:
+        return f"log10 {name} ({unit})" if unit and unit != "–" else f"log10 {name}"
+
     fig = Figure(figsize=(12.0, 9.0))
     for row, (surf, label) in enumerate(((unconstrained, "unconstrained (bounds relaxed toward zero)"),
                                          (constrained, "constrained (inside the bounds)"))):
@@ -427,13 +432,13 @@ def plot_surfaces(constrained, unconstrained, title: str, boundaries=(), marks=N
         Z = np.log10(np.where(np.isfinite(surf.values), surf.values, np.nan))
         ax = fig.add_subplot(2, 2, 2 * row + 1, projection="3d")
         ax.plot_surface(XI, XJ, Z, cmap="viridis", linewidth=0, antialiased=True)
-        ax.set_xlabel(f"log10 {surf.names[0]}", fontsize=7)
-        ax.set_ylabel(f"log10 {surf.names[1]}", fontsize=7)
-        ax.set_zlabel("log10 U", fontsize=7)
+        ax.set_xlabel(log_label(surf.names[0], units[0]), fontsize=7)
+        ax.set_ylabel(log_label(surf.names[1], units[1]), fontsize=7)
+        ax.set_zlabel(log_label("U", units[2]), fontsize=7)
         ax.set_title(label, fontsize=9)
         ax2 = fig.add_subplot(2, 2, 2 * row + 2)
         cs = ax2.contourf(XI, XJ, Z, levels=20, cmap="viridis")
-        fig.colorbar(cs, ax=ax2, label="log10 U")
+        fig.colorbar(cs, ax=ax2, label=log_label("U", units[2]))
         m = surf.minimum(inside_only=row == 1)
         ax2.plot(np.log10(m[surf.names[0]]), np.log10(m[surf.names[1]]), "c^", ms=8, label="grid minimum of U")
         if row == 1:
@@ -450,8 +455,8 @@ def plot_surfaces(constrained, unconstrained, title: str, boundaries=(), marks=N
             color, marker, ms = MARK_STYLES[k % len(MARK_STYLES)]
             ax2.plot(np.log10(values[surf.names[0]]), np.log10(values[surf.names[1]]), marker=marker, color=color,
                      ms=ms, ls="none", markeredgecolor="k", label=name)
-        ax2.set_xlabel(f"log10 {surf.names[0]}")
-        ax2.set_ylabel(f"log10 {surf.names[1]}")
+        ax2.set_xlabel(log_label(surf.names[0], units[0]))
+        ax2.set_ylabel(log_label(surf.names[1], units[1]))
         ax2.set_title(label, fontsize=9)
         ax2.legend(fontsize=7, loc="lower right", framealpha=0.85)
     fig.suptitle(title, fontsize=11)

@@ -23,6 +23,7 @@ from railopt.studies.output.figures import (
     plot_frf_panels,
     plot_root_loci_before_after,
     plot_root_locus,
+    plot_surfaces,
 )
 
 LONG = ("sd40-2: sd40-2 cab model, ±0.25 in lateral irregularity, λ = 22.35 m, constrained and unconstrained "
@@ -115,6 +116,37 @@ def test_vehicle_forced_and_tmd_axis_labels():
     assert forced.axis_label("body.alpha") == "|body.alpha| (rad/s² per 6.35 mm alignment irregularity)"
     tmd = ModelRef(label="m", model="tmd", options={"mass_ratio": 0.05}).setup("models[0]")
     assert tmd.axis_label("amplification") == "|amplification| (k1·x1 / F, dimensionless)"
+
+
+def test_design_variables_have_their_si_unit_and_the_surface_axes_show_it():
+    """A variable's unit follows from what its element is (vehicle file type) or what the TMD parameter is; the
+    objective-surface axes read ``log10 <name> (<unit>)`` and U in the objective output's unit."""
+    cab = ModelRef(label="sd40-2", model="cab_lateral").setup("models[0]")
+    pm = cab.parameter_map
+    vehicle = load_vehicle("sd40-2")
+    units = {"spring": "N/m", "damper": "N·s/m", "rotational_spring": "N·m/rad", "rotational_damper": "N·m·s/rad"}
+    for element in vehicle.elements:
+        if element.id in pm.parameters:
+            assert pm.unit(element.id) == units[element.type]
+            assert pm.unit(element.alias) == units[element.type]
+    assert pm.unit("secondary_lateral_stiffness") == "N/m"
+    assert pm.unit("lateral_shock_absorber_damping") == "N·s/m"
+    assert pm.unit("no_such_parameter") == ""
+    tmd = ModelRef(label="m", model="tmd", options={"mass_ratio": 0.05}).setup("models[0]").parameter_map
+    assert (tmd.unit("k2"), tmd.unit("c2"), tmd.unit("tuning"), tmd.unit("damping_ratio")) == ("N/m", "N·s/m", "–", "–")
+
+    from railopt.design.surface import Surface
+
+    xi, xj = np.geomspace(1e5, 1e6, 4), np.geomspace(1e7, 1e8, 3)
+    grid = Surface(("K2", "K3"), xi, xj, np.outer(xj, xi) * 1e-12, np.ones((3, 4), dtype=bool))
+    fig = plot_surfaces(grid, grid, "U over K2 × K3", units=("N/m", "N/m", "m/s²"))
+    labels = [(ax.get_xlabel(), ax.get_ylabel()) for ax in fig.axes if ax.get_xlabel()]
+    assert ("log10 K2 (N/m)", "log10 K3 (N/m)") in labels
+    assert {ax.get_zlabel() for ax in fig.axes if hasattr(ax, "get_zlabel")} == {"log10 U (m/s²)"}
+    assert "log10 U (m/s²)" in [ax.get_ylabel() for ax in fig.axes]  # the colour bars
+    bare = plot_surfaces(grid, grid, "U over K2 × K3", units=("–", "", ""))
+    assert ("log10 K2", "log10 K3") in [(ax.get_xlabel(), ax.get_ylabel()) for ax in bare.axes]
+    texts_inside(fig)
 
 
 # ---------------------------------------------------------------------------------------------- before/after

@@ -146,7 +146,8 @@ def _surface(result: CampaignResult, s: ModelSections, g: TradeoffSurfaces, writ
         writer.table(g.constrained.to_pandas().assign(**{bd.label.split(" ")[0]: bd.values.ravel()}),
                      f"{stem}_{bd.label.split(' ')[0].replace(' ', '_')}")
     writer.figure(plot_surfaces(g.constrained, g.unconstrained, f"{s.model}: U over {a} × {b}",
-                                boundaries=g.boundaries, marks=g.marks), stem, dpi=result.config.report.dpi)
+                                boundaries=g.boundaries, marks=g.marks, units=g.units), stem,
+                  dpi=result.config.report.dpi)
     cmin, umin = g.constrained.minimum(), g.unconstrained.minimum(inside_only=False)
     md = [f"Objective surface over {g.spec.variables} (others at the {next(iter(g.marks), 'optimum')} design): "
           f"least U on the constrained grid {cmin['U']:.4g} at {cmin[a]:.4g}, {cmin[b]:.4g}; on the grid relaxed "

@@ -540,7 +540,9 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
                                               else setup.required_speed), True)] if hunting else [])
     limits += [(f"{c.output} = limit", c.limit_value(setup), False) for c in cfg.constraints]
     problem = campaign_problem(cfg, setup, objective, "unconstrained")
-    grids = [surfaces(problem, spec, x_after, client, _DesignValues(cfg, setup, hunting), limits, marks)
+    u_unit = setup.units.get(cfg.objective.output or setup.family.output_names[0], "")
+    grids = [surfaces(problem, spec, x_after, client, _DesignValues(cfg, setup, hunting), limits, marks,
+                      units=(*(setup.parameter_map.unit(v) for v in spec.variables), u_unit))
              for spec in cfg.surfaces]
     return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids, recommended, reference)
 

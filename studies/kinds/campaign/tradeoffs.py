@@ -63,6 +63,7 @@ class TradeoffSurfaces:
     unconstrained: Surface
     boundaries: list[Boundary] = field(default_factory=list)
     marks: dict[str, dict[str, float]] = field(default_factory=dict)
+    units: tuple[str, str, str] = ("", "", "")  # of the two variables and of U (figure axes)
 
 
 def sweep(problems: Sequence[tuple[float, MinimaxProblem]], spec: TradeoffSpec, seed: int,
@@ -121,10 +122,11 @@ def tradeoff_table(spec: TradeoffSpec, problems: Sequence[tuple[float, MinimaxPr
 def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, base: np.ndarray, client=None,
              constraints: Callable[[np.ndarray], np.ndarray] | None = None,
              limits: Sequence[tuple[str, float, bool]] = (),
-             marks: dict[str, dict[str, float]] | None = None) -> TradeoffSurfaces:
+             marks: dict[str, dict[str, float]] | None = None,
+             units: tuple[str, str, str] = ("", "", "")) -> TradeoffSurfaces:
     """The constrained and unconstrained :class:`~railopt.design.Surface` of U over ``spec.variables`` (the others
     at ``base``), and on the constrained grid the values of ``constraints(x) -> (len(limits),)`` with their
-    ``limits`` ``(label, limit, at_least)``."""
+    ``limits`` ``(label, limit, at_least)``; ``units`` of the two variables and of U label the figure."""
     space = problem.space
     grids, axes_used = [], []
     for relaxed in (False, True):
@@ -143,4 +145,4 @@ def surfaces(problem: MinimaxProblem, spec: SurfaceSpec, base: np.ndarray, clien
         values = grid_map(constraints, space.names, spec.variables, xi, xj, base, client)  # (xj, xi, limits)
         boundaries = [Boundary(label, values[:, :, k], limit, at_least)
                       for k, (label, limit, at_least) in enumerate(limits)]
-    return TradeoffSurfaces(spec, grids[0], grids[1], boundaries, dict(marks or {}))
+    return TradeoffSurfaces(spec, grids[0], grids[1], boundaries, dict(marks or {}), tuple(units))
