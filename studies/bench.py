@@ -7,7 +7,8 @@
 2. Thesis-method U and exact (certified) U vs a dense frequency sweep: the sweep size needed to
    reach the exact option's accuracy, and the 2,000-point sweep's own error.
 3. Analytic gradient of f_k vs central finite differences.
-4. Multi-start throughput: starts/s serial vs a 2-worker dask LocalCluster.
+4. Multi-start throughput: starts/s serial vs a 2-worker dask LocalCluster, and the machine's own ceiling: the
+   same starts in plain processes at once (no dask) against one alone.
 5. Critical speed of the locomotive (rigid track): eigen-solves and time of the bracketing + Brent
    search against a dense root-locus scan at the same resolution.
 6. Exact certified U against python-control's ``linfnorm`` (SLICOT AB13DD) on the same chains without delays
@@ -182,6 +183,31 @@ def _fresh(sys: LinearSystem) -> LinearSystem:
     return LinearSystem._trusted(sys.M, sys.C, sys.K, sys.forcing, sys.outputs, sys.names)
 
 
+def _plain_rate(n_starts: int) -> float:
+    """Starts per second of the exact TMD multistart in this process, serial (one process of the ceiling row)."""
+    _, config, _ = load_study(STUDIES / "tmd_hinf.toml")
+    problem = campaign_problem(config, config.setups()["mu0.05"], "exact")
+    with threadpool_limits(1):
+        multistart(problem, 4, seed=99)  # warm (imports, caches)
+        t = time.perf_counter()
+        multistart(problem, n_starts, seed=1)
+        return n_starts / (time.perf_counter() - t)
+
+
+def _ceiling_row(workers: int, n_starts: int, serial_rate: float) -> dict:
+    """What this machine allows ``workers`` processes: the same starts in plain processes (no dask, no shared
+    work) all at once, their summed rate against one process alone.  A dask speed-up can only approach it."""
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(workers) as pool:
+        rates = pool.map(_plain_rate, [n_starts] * workers)
+    return {"benchmark": f"parallel ceiling of this machine: {workers} plain processes of the exact TMD multistart "
+                         "at once (no dask)", "ours_s": 1.0 / sum(rates), "reference_s": 1.0 / serial_rate,
+            "reference": "one process alone (serial)", "ratio": serial_rate / sum(rates),
+            "note": f"{serial_rate:.1f} starts/s alone; " + ", ".join(f"{r:.1f}" for r in rates)
+                    + f" starts/s at once ({sum(rates) / serial_rate:.2f}× at best)"}
+
+
 def _cab_throughput(workers: int, quick: bool) -> dict:
     """Starts per second of the flagship's exact cab problem, serial against a LocalCluster."""
     _, config, _ = load_study(STUDIES / "cab_lateral_minimax.toml")
@@ -351,6 +377,7 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
                  "reference": f"serial; ours = dask LocalCluster, {workers} workers",
                  "ratio": t_dask / t_serial})
     rows[-1]["note"] = f"{n_starts / t_serial:.1f} starts/s serial, {n_starts / t_dask:.1f} starts/s dask"
+    rows.append(_ceiling_row(workers, 2 * n_starts, n_starts / t_serial))
     rows.append(_cab_throughput(workers, quick))
 
     # 1. U(x) vs the floor -------------------------------------------------------------------
