@@ -25,7 +25,8 @@ CONDITION_LIMIT = 1e8  # cond₁(V) above which the pole–residue form is not u
 class Modal(ArrayRecord):
     """Eigen-decomposition of the state matrix G (4.53): roots s (2n,), right eigenvectors V
     (columns) and left ones W = V⁻¹ (rows, so W V = I); ``condition`` = ‖V‖₁‖W‖₁ (inf when V
-    is singular).
+    is exactly singular; a defective G's eigenvectors are singular only to rounding, which shows as a huge
+    condition, far past :data:`CONDITION_LIMIT`).
 
     W and the condition are worked out when first read (one solve ``V W = I``): the roots and their
     mode shapes (stability rows, root loci) never pay for them; derivatives and the pole–residue form do.
@@ -38,7 +39,8 @@ class Modal(ArrayRecord):
     def _left(self) -> tuple[np.ndarray, float]:
         try:
             W = np.linalg.solve(self.V, np.eye(self.V.shape[0]))
-            condition = float(np.linalg.norm(self.V, 1) * np.linalg.norm(W, 1))
+            with np.errstate(over="ignore"):  # an overflowing product is the inf condition below
+                condition = float(np.linalg.norm(self.V, 1) * np.linalg.norm(W, 1))
         except np.linalg.LinAlgError:
             W = np.full_like(self.V, np.nan)
             condition = float("inf")
@@ -49,12 +51,12 @@ class Modal(ArrayRecord):
 
     @property
     def W(self) -> np.ndarray:
-        """Left eigenvectors (2n, 2n), rows, W = V⁻¹ (NaN when V is singular)."""
+        """Left eigenvectors (2n, 2n), rows, W = V⁻¹ (NaN when V is exactly singular)."""
         return self._left[0]
 
     @property
     def condition(self) -> float:
-        """cond₁(V) = ‖V‖₁‖W‖₁ (inf when V is singular)."""
+        """cond₁(V) = ‖V‖₁‖W‖₁ (inf when V is exactly singular or the product overflows)."""
         return self._left[1]
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import operator
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -442,6 +443,9 @@ def _family_rows(family, p, speeds: Sequence[float], exclude: Sequence[str]):
     A mode is dropped when neutral, when lumped track bodies carry most of its energy (what
     :func:`mode_name` calls "track") or, with ``exclude``, when its name, group or a prefix is listed; the
     names are only worked out when something is excluded (the constraint rows need the mask alone)."""
+    if isinstance(exclude, str):  # a bare string would be read letter by letter
+        raise ValueError(f"exclude: a list of mode names, groups or prefixes, got the string {exclude!r}; "
+                         f"write [{exclude!r}]")
     groups, main = getattr(family, "groups", None), getattr(family, "main_body", None)
     track: np.ndarray | None = None
     for S in _speeds(speeds):
@@ -477,17 +481,28 @@ class StabilityRows:
     :func:`root_constraints`).  A derivative-free optimiser reads :meth:`roots` / :meth:`damping` only; a
     gradient method then asks :meth:`roots_jacobian` / :meth:`damping_jacobian`, which reuse the same
     decompositions (the root derivatives ds/dp, thesis eqs. (4.53)–(4.58) with the left eigenvectors, are
-    computed once per speed and shared by both kinds of row).
+    computed once per speed for each ``wrt`` asked and shared by both kinds of row).
+
+    ``family`` is a ParametricSystem with a speed term (P parameters), ``p`` its parameters (None: its values),
+    ``speeds`` (K,) in m/s, ``exclude`` a list of mode names, groups or name prefixes (never a bare string).
+    ``wrt`` (the Jacobians' columns): indices into the family's parameters, None for all P.
+
+    Raises
+    ------
+    ValueError
+        No speed, a speed ≤ 0, ``exclude`` given as a string, ``wrt`` not whole numbers in [−P, P), a
+        negative ``sigma_min``.
     """
 
     def __init__(self, family, p: Sequence[float] | None, speeds: Sequence[float], exclude: Sequence[str] = ()) -> None:
         self._members = [(system, idx, keep) for _, system, idx, keep in _family_rows(family, p, speeds, exclude)]
+        self._parameters = len(family.parameters)
         self._ds: dict[tuple[int, ...] | None, list[np.ndarray]] = {}
 
     def _root_derivatives(self, wrt: Sequence[int] | None) -> list[np.ndarray]:
-        key = None if wrt is None else tuple(int(i) for i in wrt)
-        if key not in self._ds:
-            self._ds[key] = [_wrt_jacobian(system, wrt)[idx] for system, idx, _ in self._members]
+        key = _indices("wrt", wrt, self._parameters)
+        if key not in self._ds:  # the same indices index the tangent as key the cache
+            self._ds[key] = [_wrt_jacobian(system, key)[idx] for system, idx, _ in self._members]
         return self._ds[key]
 
     def roots(self, sigma_min: float = 0.0) -> np.ndarray:
@@ -497,12 +512,13 @@ class StabilityRows:
                                for system, idx, keep in self._members])
 
     def roots_jacobian(self, wrt: Sequence[int] | None = None) -> np.ndarray:
-        """``dg/dp`` of :meth:`roots` (K·n, len(wrt)); zero rows for dropped modes."""
+        """``dg/dp`` of :meth:`roots` (K·n, len(wrt) or P), 1/s per unit of each parameter; zero rows for dropped
+        modes."""
         return np.vstack([np.where(keep[:, None], ds.real, 0.0)
                           for (_, _, keep), ds in zip(self._members, self._root_derivatives(wrt), strict=True)])
 
     def damping(self, zeta_min: float) -> np.ndarray:
-        """``g = ζ_min − ζ_j`` (K·n,) with ζ = −Re s/|s|; −1 for a dropped mode."""
+        """``g = ζ_min − ζ_j`` (K·n,), dimensionless, with ζ = −Re s/|s|; −1 for a dropped mode."""
         zeta_min = number("zeta_min", zeta_min)
         values = []
         for system, idx, keep in self._members:
@@ -511,12 +527,31 @@ class StabilityRows:
         return np.concatenate(values)
 
     def damping_jacobian(self, wrt: Sequence[int] | None = None) -> np.ndarray:
-        """``dg/dp`` of :meth:`damping` (K·n, len(wrt)) from dζ/dp = damping_ratio_jacobian(s, ds/dp)."""
+        """``dg/dp`` of :meth:`damping` (K·n, len(wrt) or P), per unit of each parameter, from
+        dζ/dp = damping_ratio_jacobian(s, ds/dp); zero rows for dropped modes."""
         jac = []
         for (system, idx, keep), ds in zip(self._members, self._root_derivatives(wrt), strict=True):
             dzeta = damping_ratio_jacobian(system.modal().s[idx], ds)
             jac.append(np.where(keep[:, None], -dzeta, 0.0))
         return np.vstack(jac)
+
+
+def _indices(name: str, wrt: object, count: int) -> tuple[int, ...] | None:
+    """``wrt`` as a tuple of whole-number indices into ``count`` parameters (None stays None: all of them)."""
+    if wrt is None:
+        return None
+    try:
+        items = list(wrt) if not isinstance(wrt, str) else None
+        if items is None or any(isinstance(i, bool | np.bool_) for i in items):  # a mask is not a list of indices
+            raise TypeError
+        out = tuple(operator.index(i) for i in items)
+    except TypeError:
+        raise ValueError(f"{name}: parameter indices must be whole numbers (for a mask use np.flatnonzero(mask)), "
+                         f"got {wrt!r}") from None
+    bad = [i for i in out if not -count <= i < count]
+    if bad:
+        raise ValueError(f"{name}: indices {bad} are outside the family's {count} parameters")
+    return out
 
 
 def root_constraints(family, p: Sequence[float] | None, speeds: Sequence[float], sigma_min: float = 0.0,

@@ -138,15 +138,19 @@ class _Evaluator:
             self._sys, self._dp, self._key, self._pieces = self.setup.family.at(p), dp, key, {}
         return self._sys, self._dp
 
-    def _piece(self, x: np.ndarray, name: tuple, compute):
+    def _piece(self, x: np.ndarray, kind: str, target: object, compute):
+        """The ``kind`` of result for ``target`` at x, computed once.  Keyed by the target object itself (held with
+        the result): a different target that happens to reuse a freed one's id is computed afresh."""
         self.system(x)  # a new x clears the pieces
-        if name not in self._pieces:
-            self._pieces[name] = compute()
-        return self._pieces[name]
+        held = self._pieces.get((kind, id(target)))
+        if held is None or held[0] is not target:
+            held = (target, compute())
+            self._pieces[(kind, id(target))] = held
+        return held[1]
 
     def _maxima(self, x: np.ndarray, t: ResponseTarget):
         sys, _ = self.system(x)
-        return self._piece(x, ("maxima", id(t)), lambda: all_response_maxima(
+        return self._piece(x, "maxima", t, lambda: all_response_maxima(
             sys, band_rad_s=t.band, exact=t.exact, outputs=[t.output])[t.output])
 
     def maxima(self, x: np.ndarray, targets: Sequence[ResponseTarget]) -> np.ndarray:
@@ -159,7 +163,7 @@ class _Evaluator:
 
     def _rms(self, x: np.ndarray, target: RMSTarget):
         sys, _ = self.system(x)
-        return self._piece(x, ("rms", id(target)), lambda: random_response(
+        return self._piece(x, "rms", target, lambda: random_response(
             sys, target.spectrum, target.speed, target.band_hz, target.output, target.rtol))
 
     def objective(self, x: np.ndarray, target: ResponseTarget | RMSTarget) -> np.ndarray:
@@ -190,7 +194,7 @@ class _Evaluator:
                             [rows[i] for i in moving]))
             return out
 
-        return self._piece(x, ("stability rows", id(target)), compute)
+        return self._piece(x, "stability rows", target, compute)
 
     def stability(self, x: np.ndarray, target: StabilityTarget) -> np.ndarray:
         """The rows of ``target`` at x: for each track, Re s + σ_min, then ζ_min − ζ when ζ_min is set."""
@@ -202,10 +206,11 @@ class _Evaluator:
                     values.append(rows.damping(target.zeta_min))
             return np.concatenate(values)
 
-        return self._piece(x, ("stability", id(target)), compute)
+        return self._piece(x, "stability", target, compute)
 
     def stability_jacobian(self, x: np.ndarray, target: StabilityTarget) -> np.ndarray:
-        """d(rows)/dx, from the members solved for :meth:`stability` (a derivative-free method never pays it)."""
+        """d(rows)/dx (rows, d), from the members solved for :meth:`stability` (a derivative-free method never pays
+        it)."""
         _, dp = self.system(x)
         jacs = []
         for rows, moving, design_rows in self._stability_rows(x, target):

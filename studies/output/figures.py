@@ -422,6 +422,9 @@ def plot_surfaces(constrained, unconstrained, title: str, boundaries=(), marks=N
     on the constrained contour panel, the infeasible side hatched; ``marks`` (label -> design values) are marked on
     both contour panels (e.g. the recommended design and the unconstrained optimum).  ``units`` of the two
     variables and of U: the axes read ``log10 <name> (<unit>)``, the value in that unit."""
+    if units is None or isinstance(units, str) or len(units) != 3:
+        raise ValueError(f"units: (unit of {constrained.names[0]}, of {constrained.names[1]}, of U), got {units!r}")
+
     def log_label(name: str, unit: str) -> str:
         return f"log10 {name} ({unit})" if unit and unit != "–" else f"log10 {name}"
 

@@ -185,3 +185,31 @@ def test_root_locus_names_its_roots_as_the_modes_table_does(conicity: float, exp
     at = locus[(locus["speed"] == above) & (locus["imag"] > 0)].reset_index(drop=True)
     assert np.allclose(at["imag"], table["imag"], rtol=1e-9, atol=1e-9)
     assert list(at["name"]) == list(table["name"])
+
+
+def test_stability_rows_solve_once_and_give_the_asked_columns() -> None:
+    """:class:`StabilityRows`: the Jacobian of any ``wrt`` is the full Jacobian's columns (any order, repeats,
+    negative indices, a numpy array or a generator), the damping rows share the root derivatives, and what is not
+    a list of indices is refused by name (a mask, floats, an index out of range, a bare-string exclude)."""
+    from railopt.models.stability import StabilityRows
+
+    family = load_vehicle("sd40-2").lateral("rigid").family(["K2", "K3", "C13", "C15"])
+    rows = StabilityRows(family, None, [10.0, 20.0, 30.0])
+    full_roots, full_damping = rows.roots_jacobian(), rows.damping_jacobian()
+    assert full_roots.shape == (3 * family.n, 4)
+    for wrt, cols in (([0, 2], [0, 2]), ((i for i in [3, 1]), [3, 1]), (np.array([2, 0]), [2, 0]),
+                      ([1, 1], [1, 1]), ([-1], [3]), (range(4), [0, 1, 2, 3])):
+        fresh = StabilityRows(family, None, [10.0, 20.0, 30.0])
+        np.testing.assert_array_equal(fresh.roots_jacobian(wrt), full_roots[:, cols])
+        np.testing.assert_array_equal(rows.damping_jacobian(list(cols)), full_damping[:, cols])
+    assert rows.roots_jacobian([]).shape == (3 * family.n, 0)
+    g, J = root_constraints(family, None, [10.0, 20.0, 30.0], wrt=[1, 3])
+    np.testing.assert_array_equal(g, rows.roots())
+    np.testing.assert_array_equal(J, full_roots[:, [1, 3]])
+    for bad in (np.array([True, False, True, False]), [True, False], np.array([0.0, 2.0]), "01", 3):
+        with pytest.raises(ValueError, match="wrt: parameter indices must be whole numbers"):
+            rows.roots_jacobian(bad)
+    with pytest.raises(ValueError, match=r"wrt: indices \[4\] are outside the family's 4 parameters"):
+        rows.damping_jacobian([4])
+    with pytest.raises(ValueError, match=r"exclude: .* got the string 'body lateral'; write \['body lateral'\]"):
+        StabilityRows(family, None, [10.0], exclude="body lateral")

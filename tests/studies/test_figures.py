@@ -144,6 +144,9 @@ def test_design_variables_have_their_si_unit_and_the_surface_axes_show_it():
     assert ("log10 K2 (N/m)", "log10 K3 (N/m)") in labels
     assert {ax.get_zlabel() for ax in fig.axes if hasattr(ax, "get_zlabel")} == {"log10 U (m/s²)"}
     assert "log10 U (m/s²)" in [ax.get_ylabel() for ax in fig.axes]  # the colour bars
+    for bad in (("N/m", "N/m"), None, "N/m"):
+        with pytest.raises(ValueError, match=r"units: \(unit of K2, of K3, of U\)"):
+            plot_surfaces(grid, grid, "U over K2 × K3", units=bad)
     bare = plot_surfaces(grid, grid, "U over K2 × K3", units=("–", "", ""))
     assert ("log10 K2", "log10 K3") in [(ax.get_xlabel(), ax.get_ylabel()) for ax in bare.axes]
     texts_inside(fig)

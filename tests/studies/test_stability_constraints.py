@@ -243,3 +243,27 @@ def test_maxima_of_another_band_or_method_are_refused() -> None:
     reused = maxima_jacobians(sys_, band_rad_s=band, outputs=["cab_acceleration"], maxima=thesis)
     fresh = maxima_jacobians(sys_, band_rad_s=band, outputs=["cab_acceleration"])
     np.testing.assert_array_equal(reused["cab_acceleration"][1], fresh["cab_acceleration"][1])
+
+
+def test_a_target_reusing_a_freed_targets_id_is_computed_afresh() -> None:
+    """The evaluator keeps each piece with the target it belongs to: a new target object that Python gave a freed
+    one's id (simulated by moving the cached piece under the new id) gets its own rows, not the stale ones."""
+    from dataclasses import replace
+
+    from railopt.studies.adapter import _Evaluator
+
+    config = load_study(STUDIES_DIR / "cab_lateral_minimax.toml")[1]
+    setup = config.setups()["sd40-2"]
+    names = [v.name for v in config.design.variables]
+    x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
+    first = replace(config.stability.target(setup), speeds=(15.0, 20.0, 25.0), sigma_min=0.0)
+    second = replace(first, speeds=(26.0, 28.0, 30.0), sigma_min=0.5)
+    evaluator = _Evaluator(setup, names)
+    stale = evaluator.stability(x, first)
+    for kind in ("stability", "stability rows"):
+        evaluator._pieces[(kind, id(second))] = evaluator._pieces.pop((kind, id(first)))
+    rows = evaluator.stability(x, second)
+    expected = _Evaluator(setup, names)
+    np.testing.assert_array_equal(rows, expected.stability(x, second))
+    np.testing.assert_array_equal(evaluator.stability_jacobian(x, second), expected.stability_jacobian(x, second))
+    assert not np.array_equal(rows, stale)

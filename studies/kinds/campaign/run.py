@@ -536,9 +536,10 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
     if reference is not None:
         marks["unconstrained optimum"] = reference["values"]
     hunting = "hunting" in setup.checks and bool(setup.stability)
-    limits = ([("critical speed = required", (cfg.stability.required(setup) if cfg.stability is not None
-                                              else setup.required_speed), True)] if hunting else [])
-    limits += [(f"{c.output} = limit", c.limit_value(setup), False) for c in cfg.constraints]
+    limits = ([("critical speed (m/s) = required", (cfg.stability.required(setup) if cfg.stability is not None
+                                                    else setup.required_speed), True)] if hunting else [])
+    limits += [(f"{c.output} ({setup.units[c.output]}) = limit" if setup.units.get(c.output) else f"{c.output} = limit",
+                c.limit_value(setup), False) for c in cfg.constraints]
     problem = campaign_problem(cfg, setup, objective, "unconstrained")
     u_unit = setup.units.get(cfg.objective.output or setup.family.output_names[0], "")
     grids = [surfaces(problem, spec, x_after, client, _DesignValues(cfg, setup, hunting), limits, marks,
