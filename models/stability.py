@@ -565,7 +565,6 @@ def root_constraints(family, p: Sequence[float] | None, speeds: Sequence[float],
     ``wrt`` the indices of the parameters to differentiate (default all; the Jacobian has one column each).
     Values alone, or values now and derivatives later: :class:`StabilityRows`.
     """
-    sigma_min = number("sigma_min", sigma_min, non_negative=True)
     rows = StabilityRows(family, p, speeds, exclude)
     return rows.roots(sigma_min), rows.roots_jacobian(wrt)
 
@@ -577,7 +576,6 @@ def damping_constraints(family, p: Sequence[float] | None, speeds: Sequence[floa
     Conventions as :func:`root_constraints` (excluded rows −1); ζ = −Re s/|s| with
     dζ/dp from the root derivatives.  Returns ``(g (K·n,), dg/dp (K·n, P))``.
     """
-    zeta_min = number("zeta_min", zeta_min)
     rows = StabilityRows(family, p, speeds, exclude)
     return rows.damping(zeta_min), rows.damping_jacobian(wrt)
 

@@ -128,6 +128,7 @@ class _Evaluator:
         self.setup, self.names = setup, list(names)
         self._key: bytes | None = None
         self._sys: LinearSystem | None = None
+        self._p: np.ndarray | None = None
         self._dp: np.ndarray | None = None
         self._pieces: dict = {}
 
@@ -135,7 +136,7 @@ class _Evaluator:
         key = np.asarray(x, dtype=float).tobytes()
         if key != self._key:
             p, dp = self.setup.parameters(self.names, np.asarray(x, dtype=float))
-            self._sys, self._dp, self._key, self._pieces = self.setup.family.at(p), dp, key, {}
+            self._sys, self._p, self._dp, self._key, self._pieces = self.setup.family.at(p), p, dp, key, {}
         return self._sys, self._dp
 
     def _piece(self, x: np.ndarray, kind: str, target: object, compute):
@@ -183,7 +184,7 @@ class _Evaluator:
         family and in the design family."""
         def compute():
             _, dp = self.system(x)
-            p, _ = self.setup.parameters(self.names, np.asarray(x, dtype=float))
+            p = self._p  # the parameters of the system just built for x
             params = list(self.setup.family.parameters)
             out = []
             for track in target.tracks:
@@ -235,7 +236,8 @@ class _Evaluator:
         return np.vstack(self._constraint_parts(x, targets, stability, jacobian=True))
 
     def __getstate__(self) -> dict:  # ship to dask workers without the cached system
-        return {"setup": self.setup, "names": self.names, "_key": None, "_sys": None, "_dp": None, "_pieces": {}}
+        return {"setup": self.setup, "names": self.names, "_key": None, "_sys": None, "_p": None, "_dp": None,
+                "_pieces": {}}
 
 
 def minimax_problem(
