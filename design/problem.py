@@ -94,14 +94,17 @@ class MinimaxProblem:
 
     @property
     def variables(self) -> tuple[DesignVariable, ...]:
+        """The design variables, in the order of x."""
         return self.space.variables
 
     @property
     def has_constraints(self) -> bool:
+        """True when the problem has constraint functions g_i(x) ≤ 0."""
         return self._constraints is not None
 
     @property
     def has_analytic_gradient(self) -> bool:
+        """True when a Jacobian function was given (otherwise gradients are finite differences)."""
         return self._jacobian is not None
 
     # ------------------------------------------------------------------ evaluation

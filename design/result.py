@@ -81,8 +81,10 @@ class SolveResult(ArrayRecord):
 
     @property
     def feasible(self) -> bool:
+        """True when the constraint and bound violations are both within ``FEASIBILITY_TOL``."""
         return self.constraint_violation <= FEASIBILITY_TOL and self.bound_violation <= FEASIBILITY_TOL
 
     @property
     def success(self) -> bool:
+        """True for a converged status with a feasible point and a finite value."""
         return self.status in SUCCESS_STATUSES and self.feasible and np.isfinite(self.value)

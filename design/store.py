@@ -373,16 +373,20 @@ class CampaignStore:
 
     # ------------------------------------------------------------------ reading
     def meta(self) -> dict[str, str]:
+        """The store's ``meta`` table as a dict (string keys and values: format version, package versions, …)."""
         return dict(self._db.execute("SELECT key, value FROM meta").fetchall())
 
     @property
     def config_hash(self) -> str:
+        """Hash of the campaign's configuration, which a resumed run must match."""
         return self._db.execute("SELECT config_hash FROM campaign").fetchone()[0]
 
     def config(self) -> dict[str, Any]:
+        """The campaign's configuration as stored (parsed JSON)."""
         return json.loads(self._db.execute("SELECT config_json FROM campaign").fetchone()[0])
 
     def variables(self) -> list[str]:
+        """Names of the design variables, in the order of x."""
         return json.loads(self._db.execute("SELECT variables_json FROM campaign").fetchone()[0])
 
     def finished_ids(self, retry_failed: bool = False) -> set[int]:
@@ -417,6 +421,7 @@ class CampaignStore:
         return df.drop(columns=["x0_json", "x_json", "functions_json"])
 
     def checks(self) -> pd.DataFrame:
+        """The ``checks`` table, one row per (start, check) ordered so, with ``payload`` parsed from its JSON column."""
         with self._reading():
             df = pd.read_sql_query("SELECT * FROM checks ORDER BY start_id, name", self._db)
         df["payload"] = [json.loads(s) for s in df.pop("payload_json")]

@@ -29,6 +29,7 @@ class Surface(ArrayRecord):
     inside: np.ndarray  # True where the grid point satisfies the bounds
 
     def to_pandas(self) -> pd.DataFrame:
+        """The grid as a long table: one row per point with both variables, ``U`` and ``inside_bounds``."""
         XI, XJ = np.meshgrid(self.xi, self.xj)
         return pd.DataFrame({self.names[0]: XI.ravel(), self.names[1]: XJ.ravel(), "U": self.values.ravel(),
                              "inside_bounds": self.inside.ravel()})

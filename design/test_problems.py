@@ -20,6 +20,12 @@ from railopt.design.variables import DesignVariable
 
 @dataclass(frozen=True)
 class TestProblem:
+    """A minimax test problem with its start and known optimum.
+
+    ``start`` is x0, shape (d,); ``optimum_value`` is U at the optimum and ``optimum_x`` the optimum x (or
+    ``None`` where only the value is published).
+    """
+
     name: str
     problem: MinimaxProblem
     start: np.ndarray

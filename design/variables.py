@@ -62,6 +62,7 @@ class Space:
 
     @property
     def dim(self) -> int:
+        """Number of design variables d."""
         return len(self.variables)
 
     def to_x(self, u: np.ndarray) -> np.ndarray:
@@ -79,6 +80,10 @@ class Space:
         return np.clip(x, self.lower, self.upper)
 
     def to_u(self, x: np.ndarray) -> np.ndarray:
+        """Unit-cube coordinates u of design x, shape (..., d): the inverse of :meth:`to_x`.
+
+        Linear variables map affinely, log variables through ``log x``; points outside the bounds give u outside [0, 1].
+        """
         x = np.asarray(x, dtype=float)
         with np.errstate(divide="ignore", invalid="ignore"):
             y = np.where(self.log, np.log(np.where(self.log, x, 1.0)), x)
@@ -96,6 +101,11 @@ class Space:
         return float(np.max(np.maximum(0.0, np.maximum(self.lower - x, x - self.upper)) / span))
 
     def check_point(self, x: Sequence[float], field: str = "x0") -> np.ndarray:
+        """x as a float array of shape (d,), checked and placed onto the bounds.
+
+        Raises ValueError (prefixed by ``field``) for a wrong shape, a NaN or infinite entry, or a point outside
+        the bounds by more than 1e-12 of a variable's range; within that tolerance the point is clipped.
+        """
         x = np.asarray(x, dtype=float)
         if x.shape != (self.dim,):
             raise ValueError(f"{field}: expected {self.dim} values for {self.names}, got shape {x.shape}")

@@ -154,10 +154,12 @@ class AccelerationRecord:
 
     @property
     def duration_s(self) -> float:
+        """Length of the record in seconds: samples / ``sample_rate_hz``."""
         return len(self.az) / self.sample_rate_hz
 
     @property
     def time_s(self) -> np.ndarray:
+        """Sample times in seconds, shape (n,), starting at 0."""
         return np.arange(len(self.az)) / self.sample_rate_hz
 
 

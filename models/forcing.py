@@ -35,6 +35,10 @@ class DelayedTerm:
     function: Callable[[float], np.ndarray] | None = None
 
     def amplitude(self, omega: float) -> np.ndarray:
+        """The amplitude ``a(Ω)`` at ``omega`` (rad/s), complex, shape (n,) (without the delay factor).
+
+        Polynomial terms evaluate ``Σ_j (iΩ)^j coefficients[j]``; callable terms return ``function(omega)``.
+        """
         if self.coefficients is not None:
             powers = (1j * omega) ** np.arange(self.coefficients.shape[0])
             return powers @ self.coefficients
@@ -50,6 +54,7 @@ class DelayedTerm:
         return (1j * j * (1j * omega) ** (j - 1)) @ self.coefficients[1:]
 
     def scaled(self, factor: float) -> DelayedTerm:
+        """The same term with its amplitude multiplied by ``factor`` (same delay; polynomial terms stay polynomial)."""
         if self.coefficients is not None:
             return DelayedTerm(self.delay, coefficients=factor * self.coefficients)
         fn = self.function
@@ -286,6 +291,7 @@ class DistanceForcing:
 
     @property
     def n(self) -> int:
+        """Number of coordinates the forcing acts on (length of each amplitude vector)."""
         return self.terms[0][0].shape[1]
 
     def at_speed(self, speed: float) -> Forcing:

@@ -157,14 +157,17 @@ class ParametricSystem:
     # ------------------------------------------------------------------ description
     @property
     def n(self) -> int:
+        """Number of degrees of freedom (size of M, C and K)."""
         return self._base.n
 
     @property
     def output_names(self) -> tuple[str, ...]:
+        """Names of the output rows, in order (the first is the default output)."""
         return self._base.output_names
 
     @property
     def names(self) -> tuple[str, ...]:
+        """Names of the parameters (the parts of the family), in the order of a parameter vector."""
         return self._base.names
 
     @property

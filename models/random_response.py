@@ -71,6 +71,7 @@ class QuadratureRule:
 
     @property
     def frequencies_hz(self) -> np.ndarray:
+        """The nodes in Hz: ``omega / 2π``, shape (n,)."""
         return self.omega / TWO_PI
 
     def integrate(self, values: np.ndarray) -> float:

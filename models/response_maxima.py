@@ -109,6 +109,7 @@ class ResponseMaxima(ArrayRecord):
 
     @property
     def labels(self) -> tuple[str, ...]:
+        """Label of each candidate f_k: ``mode 1`` … ``mode n`` for the resonance peaks, then the two band edges."""
         n = len(self.damped_frequencies)
         return tuple(f"mode {j + 1}" for j in range(n)) + ("lower edge", "upper edge")
 

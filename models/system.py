@@ -45,6 +45,7 @@ class Output:
 
     @property
     def order(self) -> int:
+        """Derivative order of the quantity: 0 displacement, 1 velocity, 2 acceleration."""
         return RESPONSE_ORDER[self.quantity]
 
     def feedthrough_values(self, omega: np.ndarray) -> np.ndarray:
@@ -153,6 +154,7 @@ class LinearSystem:
 
     @property
     def output_names(self) -> tuple[str, ...]:
+        """Names of the output rows, in order (the first is the default output)."""
         return tuple(self.outputs)
 
     def _out(self, output: str | None) -> Output:
@@ -177,6 +179,7 @@ class LinearSystem:
 
     @property
     def order(self) -> int:
+        """Derivative order of the default (first) output: 0 displacement, 1 velocity, 2 acceleration."""
         return self._out(None).order
 
     @property

@@ -109,16 +109,39 @@ class Outcome:
 
 
 class Method(Protocol):
+    """The contract of a local solver of the scaled epigraph problem (an extension point).
+
+    A method is an object with a ``name`` (the key in :data:`METHODS` and in ``[design] method``), a flag
+    ``uses_gradient`` (whether it asks the view for Jacobians) and ``defaults``, its own options with their default
+    values: :func:`~railopt.design.solve.method_options` merges them over the common ones (``xtol``, ``ftol``,
+    ``maxeval``, ``maxtime``), lets the caller override any of them and rejects other names.  Make one known with
+    :func:`register`; see :class:`~railopt.design.methods.nlopt_methods.NloptMethod` and
+    :class:`~railopt.design.methods.slp.SLPMethod`.
+    """
+
     name: str
     uses_gradient: bool
     defaults: Mapping[str, Any]
 
-    def run(self, view: EpigraphView, u0: np.ndarray, options: Mapping[str, Any]) -> Outcome: ...
+    def run(self, view: EpigraphView, u0: np.ndarray, options: Mapping[str, Any]) -> Outcome:
+        """Solve from ``u0`` and return the :class:`Outcome`.
+
+        ``view`` evaluates the problem in unit-cube coordinates u ∈ [0, 1]^d (shape (d,)) with the functions divided by
+        ``view.scale``; it counts evaluations and raises :class:`StopSolve` at ``maxeval``/``maxtime``, which the method
+        catches and reports as the outcome's status (``converged``, ``maxeval``, ``maxtime``, ``error`` when the
+        problem's functions raised, or ``failure``).  The
+        outcome's ``tau`` is in the problem's units (multiplied back by ``view.scale``).  A method must not raise for a
+        failed solve: it returns status ``failure`` with a message.
+        """
 
 
 METHODS: dict[str, Method] = {}
 
 
 def register(method: Method) -> Method:
+    """Make ``method`` available under ``method.name`` in :data:`METHODS`; returns it (usable as a decorator).
+
+    A second registration under the same name replaces the first.
+    """
     METHODS[method.name] = method
     return method

@@ -36,6 +36,12 @@ class NloptMethod:
     defaults: Mapping[str, Any] = field(default_factory=dict)
 
     def run(self, view: EpigraphView, u0: np.ndarray, options: Mapping[str, Any]) -> Outcome:
+        """Solve the epigraph NLP ``min τ s.t. f_k(u) ≤ τ, g_i(u) ≤ 0, 0 ≤ u ≤ 1`` with NLopt's ``algorithm``.
+
+        The variables are z = (u, τ), shape (d+1,); τ starts just above the start's scaled value and is bounded
+        to a wide finite interval.  NLopt's result code maps to ``converged``/``maxeval``/``maxtime``/``failure``; a
+        :class:`~railopt.design.methods.base.StopSolve` returns the best point the view has seen.
+        """
         import nlopt
 
         d = view.space.dim

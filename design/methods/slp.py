@@ -26,6 +26,12 @@ def _merit(f: np.ndarray, g: np.ndarray, penalty: float) -> float:
 
 @dataclass(frozen=True)
 class SLPMethod:
+    """Madsen's sequential linear programming with a trust region, as a :class:`~railopt.design.methods.base.Method`.
+
+    Options: ``initial_radius`` (Δ_0 in unit-cube coordinates), ``penalty`` (σ on the constraint excess) and
+    ``lp_solver`` (a cvxpy solver name, HiGHS by default).
+    """
+
     name: str = "slp"
     uses_gradient: bool = True
     defaults: Mapping[str, Any] = field(
@@ -33,6 +39,11 @@ class SLPMethod:
     )
 
     def run(self, view: EpigraphView, u0: np.ndarray, options: Mapping[str, Any]) -> Outcome:
+        """Iterate the trust-region LP of the module docstring from ``u0`` (unit cube, shape (d,)).
+
+        Stops ``converged`` when the predicted decrease falls below ``ftol`` or Δ below ``xtol``; ``failure`` when
+        U = inf at the start or the LP subproblem fails; ``maxeval``/``maxtime`` (best point seen) from the view.
+        """
         import cvxpy as cp
 
         d = view.space.dim

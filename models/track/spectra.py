@@ -185,6 +185,7 @@ class TabulatedSpectrum:
 
     @property
     def validity(self) -> tuple[float, float]:
+        """The wavenumber range (Ω_0, Ω_last) of the table, rad/m: the spectrum is valid there only."""
         return float(self.wavenumbers[0]), float(self.wavenumbers[-1])
 
     def psd(self, wavenumber_rad_per_m: object) -> np.ndarray | float:

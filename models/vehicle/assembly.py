@@ -103,10 +103,12 @@ class Assembly(SuspensionMatrices):
 
 
 def track_body_name(wheelset: str) -> str:
+    """Name of the lumped-track body under ``wheelset`` on flexible track (``<wheelset>_track``)."""
     return f"{wheelset}_track"
 
 
 def rail_name(wheelset: str) -> str:
+    """Name of the rail under ``wheelset`` (``<wheelset>_rail``); its ``v``, ``w`` coordinates are inputs."""
     return f"{wheelset}_rail"
 
 

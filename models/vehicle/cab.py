@@ -60,6 +60,7 @@ class CabInput:
 
     @property
     def band_rad_s(self) -> tuple[float, float]:
+        """The frequency band of the cab study, rad/s: (0, 2π ``max_frequency_hz``)."""
         return 0.0, hz_to_rad_s(self.max_frequency_hz)
 
 

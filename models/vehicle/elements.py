@@ -89,6 +89,7 @@ class Element:
 
     @property
     def rotational(self) -> bool:
+        """True for rotational springs and dampers (N·m/rad, N·m·s/rad), False for translational ones."""
         return ELEMENT_TYPES[self.type][1]
 
     def mirrored_y(self) -> Element:

@@ -44,6 +44,10 @@ Outputs = Sequence[str | PointOutput] | str | PointOutput
 
 
 def check_quantity(quantity: str) -> str:
+    """``quantity`` unchanged when it is ``displacement``, ``velocity`` or ``acceleration``.
+
+    Raises ValueError naming the valid quantities otherwise.
+    """
     if quantity not in RESPONSE_ORDER:
         raise ValueError(f"quantity: must be one of {sorted(RESPONSE_ORDER)}, got {quantity!r}")
     return quantity

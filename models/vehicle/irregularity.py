@@ -134,6 +134,7 @@ class Irregularity:
 
     @property
     def label(self) -> str:
+        """A short label for legends: kind, rails, amplitude (m) and, for a fixed wavelength, L (m)."""
         fixed = "" if self.wavelength_m is None else f", L = {self.wavelength_m:g} m"
         return f"{self.kind} {self.rails} a = {self.amplitude_m:g} m{fixed}"
 

@@ -58,6 +58,7 @@ class PointOutput:
 
     @property
     def label(self) -> str:
+        """The output's name, or ``<body>[x,y,z].<direction>`` built from the point offset (m) and direction."""
         if self.name:
             return self.name
         off = ",".join(f"{c:g}" for c in self.offset_m)
@@ -76,6 +77,7 @@ class OutputRow:
 
     @property
     def has_feedthrough(self) -> bool:
+        """True when the input enters the output directly (some ``feed`` entry is non-zero)."""
         return bool(np.any(self.feed != 0.0))
 
 

@@ -205,6 +205,7 @@ class ElementSchema(Strict):
 
     @property
     def value(self) -> float | str:
+        """The element's value, read from the key of its type (``stiffness_N_per_m``, ``damping_N_s_per_m``, …)."""
         return getattr(self, VALUE_KEYS[self.type])
 
 

@@ -70,12 +70,17 @@ class Vehicle:
 
     # ------------------------------------------------------------------ parameters
     def body(self, name: str) -> Body:
+        """The body called ``name``.
+
+        Raises ValueError listing the bodies when there is none by that name.
+        """
         for b in self.bodies:
             if b.name == name:
                 return b
         raise ValueError(f"unknown body {name!r}; bodies: {[b.name for b in self.bodies]}")
 
     def element_ids(self) -> tuple[str, ...]:
+        """The element ids (the designable parameters), each once, in file order; symmetric pairs share one id."""
         return tuple(dict.fromkeys(e.id for e in self.elements))
 
     def element_aliases(self) -> dict[str, str]:

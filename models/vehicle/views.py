@@ -141,6 +141,7 @@ class VehicleView(SuspensionMatrices):
 
     @property
     def n_dof(self) -> int:
+        """Number of degrees of freedom of the view (its independent coordinates)."""
         return len(self.coordinates)
 
     def at_speed(self, speed: float) -> VehicleView:

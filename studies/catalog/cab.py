@@ -23,6 +23,14 @@ __all__ = ["CabOptions", "cab_lateral_setup"]
 
 
 class CabOptions(StrictModel):
+    """Options of the ``cab_lateral`` model (thesis §4.3.3), in the thesis's inch-pound units where named so.
+
+    ``amplitude_in`` is the lateral irregularity (in); the band runs to ``max_frequency_hz``, reached at
+    ``max_speed_mph`` (``fixed_wavelength``: λ = S_max / f_max, every frequency at its own speed) or with the speed
+    fixed at ``max_speed_mph`` (``fixed_speed``).  ``max_operating_speed_mph`` and ``critical_search_mph`` set the
+    hunting check; ``parameters`` override values of the vehicle file.
+    """
+
     vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
     amplitude_in: float = Field(0.25, gt=0, lt=100, allow_inf_nan=False, description="lateral irregularity, in")
     max_frequency_hz: float = Field(3.0, gt=0, lt=1000, allow_inf_nan=False)
@@ -38,6 +46,13 @@ class CabOptions(StrictModel):
                 "thesis §4.3.3 cab model: body lateral/roll/yaw on the secondary suspension, trucks following a "
                 "lateral irregularity; outputs cab_acceleration (m/s²), cab_displacement, strokes")
 def cab_lateral_setup(options: CabOptions) -> ModelSetup:
+    """The thesis §4.3.3 cab model of the options' vehicle as a catalog :class:`ModelSetup`.
+
+    Body lateral/roll/yaw on the secondary suspension with the trucks following the lateral irregularity; the
+    outputs (``cab_acceleration``, ``cab_displacement``, the strokes) are labelled in m, m/s or m/s² (``body_roll``
+    in rad); stability families on rigid and flexible track.  Errors of the vehicle file or the options raise
+    ValueError naming the field.
+    """
     vehicle = load(options)
     cab = cab_lateral_model(vehicle, CabInput(options.amplitude_in * INCH, options.max_frequency_hz,
                                               options.max_speed_mph * MPH, options.mode))

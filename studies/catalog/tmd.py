@@ -13,6 +13,8 @@ __all__ = ["TMDOptions", "tmd_setup"]
 
 
 class TMDOptions(StrictModel):
+    """Options of the ``tmd`` model: mass ratio μ = m2/m1, primary mass m1 (kg) and primary natural frequency (Hz)."""
+
     mass_ratio: float = Field(gt=0, le=10, allow_inf_nan=False, description="absorber / primary mass")
     primary_mass_kg: float = Field(1000.0, gt=0, lt=1e12, allow_inf_nan=False)
     primary_frequency_hz: float = Field(2.0, gt=0, lt=1e6, allow_inf_nan=False)

@@ -146,6 +146,11 @@ class HuntingOptions(StrictModel):
 
 
 class VehicleOptions(HuntingOptions):
+    """Options of the ``vehicle_lateral`` model: vehicle file, track, forward speed (m/s), output row, overrides.
+
+    With the hunting-check options of :class:`HuntingOptions`; ``output`` defaults to the first coordinate.
+    """
+
     vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
     track: Literal["rigid", "flexible"] = "rigid"
     speed_m_s: float = Field(30.0, gt=0, lt=1000, allow_inf_nan=False, description="forward speed of `system`")
@@ -174,6 +179,13 @@ class IrregularityOptions(StrictModel):
 
 
 class VehicleForcedOptions(HuntingOptions):
+    """Options of the ``vehicle_forced`` model: a vehicle view forced by a sinusoidal rail irregularity.
+
+    ``view`` vertical or lateral, on rigid or flexible ``track`` at ``speed_m_s`` (m/s); ``input`` the irregularity
+    (kind, amplitude per rail in m, rail phasing); ``outputs`` coordinates, named rows or body points, as
+    ``quantity`` (displacement, velocity or acceleration); ``parameters`` override values of the vehicle file.
+    """
+
     vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
     track: Literal["rigid", "flexible"] = "rigid"
     speed_m_s: float = Field(30.0, gt=0, lt=1000, allow_inf_nan=False, description="forward speed S, m/s")

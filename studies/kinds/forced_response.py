@@ -52,6 +52,12 @@ class PanelSpec(FiniteModel):
 
 
 class BandSpec(FiniteModel):
+    """A frequency band of a group: ``points`` frequencies (Hz, linear or log spacing) over ``band_hz``.
+
+    The lower edge must be > 0 Hz: the vertical block has a free fore-aft translation, so Z(0) is singular.
+    ``plot`` = false computes the band's responses and peaks without a figure.
+    """
+
     label: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
     band_hz: BandHz
     points: int = Field(300, ge=2, le=20_000, strict=True)
@@ -67,6 +73,12 @@ class BandSpec(FiniteModel):
 
 
 class GroupSpec(FiniteModel):
+    """A rigid/flexible comparison: the labels of the two models, the panels (one output each) and the bands.
+
+    With ``wavelength_m`` the group runs the thesis's sweep at a fixed wavelength (S = f L) instead of at the
+    models' speeds.
+    """
+
     label: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
     rigid: str = Field(description="label of the rigid-track model")
     flexible: str = Field(description="label of the flexible-track model")
@@ -78,6 +90,13 @@ class GroupSpec(FiniteModel):
 
 
 class ForcedResponseConfig(ModelsStudy):
+    """The config model of the ``forced_response`` kind (thesis §4.3.2, Figs 4.5–4.12).
+
+    ``[[models]]`` must be ``vehicle_forced`` models; every group names a rigid-track and a flexible-track model among
+    them (each on that track), and every panel's output must be an output of both.  ``track_mode_min_hz`` sets the
+    modes listed in ``modes.csv``.
+    """
+
     KIND: ClassVar[str] = "forced_response"
     groups: list[GroupSpec] = Field(min_length=1)
     track_mode_min_hz: float = Field(15.0, gt=0, allow_inf_nan=False,
@@ -244,6 +263,13 @@ def _curves_and_figures(g: GroupSpec, models: dict, out: _Group) -> tuple[list[p
 
 
 def compute(config: ForcedResponseConfig, context: StudyContext) -> ForcedResult:
+    """The FRFs, peaks, modes and checks of every group (data only; writes nothing).
+
+    For each group and track: one system per output quantity, its responses on every band grid (amplitude per the
+    irregularity amplitude, phase to the leading axle's profile) and the certified band maxima, or (fixed wavelength)
+    grid maxima refined by Brent; the flexible/rigid ratio of each peak; the flexible model's modes above
+    ``track_mode_min_hz``.  A root with Re s > 0 or a residual of Z X = F above 1e-10 becomes a check line.
+    """
     cfg = config
     curves, figures, groups = [], [], []
     for gi, g in enumerate(cfg.groups):
@@ -262,6 +288,7 @@ def compute(config: ForcedResponseConfig, context: StudyContext) -> ForcedResult
 
 
 def report(result: ForcedResult, writer: Writer) -> str:
+    """Write the panel figures and ``frf``, ``peaks`` (and ``modes``) tables; return the summary markdown."""
     cfg = result.config
     for f in result.figures:
         fig = plot_forced_response(f.series, title=f.title, peaks=f.peaks, note=f.note, log_frequency=f.log_frequency,

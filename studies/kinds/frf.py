@@ -41,6 +41,11 @@ class DesignSpec(FiniteModel):
         return self
 
     def resolve(self, setup: ModelSetup, where: str) -> dict[str, float]:
+        """{variable: value} of this design on ``setup``: the named design's values or the explicit ones.
+
+        Raises ValueError, prefixed by ``where``, for an unknown named design, names that are not parameters of the
+        model, or values outside the parameters' physical limits.
+        """
         if self.named is not None:
             if self.named not in setup.named_designs:
                 raise ValueError(f"{where}.named: no named design {self.named!r}; known: {sorted(setup.named_designs)}")
@@ -53,6 +58,8 @@ class DesignSpec(FiniteModel):
 
 
 class GridSpec(FiniteModel):
+    """The frequency grid: ``points`` frequencies over ``band_hz`` (Hz), linear or log (log: lower edge > 0)."""
+
     band_hz: BandHz
     points: int = Field(1000, ge=2, le=200_000, strict=True)
     spacing: Literal["linear", "log"] = "linear"
@@ -64,11 +71,17 @@ class GridSpec(FiniteModel):
         return self
 
     def frequencies_hz(self) -> np.ndarray:
+        """The grid's frequencies in Hz, shape (points,), increasing, both edges included."""
         lo, hi = self.band_hz
         return np.geomspace(lo, hi, self.points) if self.spacing == "log" else np.linspace(lo, hi, self.points)
 
 
 class FRFStudyConfig(ModelsStudy):
+    """The config model of the ``frf`` kind: models, designs, outputs (empty = all), the grid and figure dpi.
+
+    Validation resolves every design on every model, so unknown named designs or parameters fail before a run.
+    """
+
     KIND: ClassVar[str] = "frf"
     designs: list[DesignSpec] = Field(min_length=1)
     outputs: list[str] = Field(default_factory=list, description="outputs to compute; empty = all")
@@ -127,6 +140,10 @@ def _model_curves(cfg: FRFStudyConfig, i: int, ref, f_hz: np.ndarray, band: tupl
 
 
 def compute(config: FRFStudyConfig, context: StudyContext) -> FRFResult:
+    """|H| and phase on the grid and the certified band maximum of every model × design × output.
+
+    Frequencies in Hz in the tables; the maxima are the exact option of (4.71)–(4.73) over ``grid.band_hz``.
+    """
     cfg = config
     f_hz = cfg.grid.frequencies_hz()
     band = (cfg.grid.band_hz[0] * HZ, cfg.grid.band_hz[1] * HZ)
@@ -140,6 +157,7 @@ def compute(config: FRFStudyConfig, context: StudyContext) -> FRFResult:
 
 
 def report(result: FRFResult, writer: Writer) -> str:
+    """Write ``frf`` and ``peaks`` tables and the ``frf`` figure; return the summary markdown."""
     cfg = result.config
     writer.table(result.frf, "frf")
     writer.table(result.table, "peaks")

@@ -63,6 +63,13 @@ class RideCase(FiniteModel):
 
 
 class RideStudyConfig(ModelsStudy):
+    """The config model of the ``ride`` kind: ``[[models]]``, ``[[cases]]``, the multistart settings and the PSD grid.
+
+    Validation checks every case against its model (the label, a forward speed over a rail irregularity, an
+    acceleration output, the design variables, a band above 0 Hz within the spectrum's validity), naming
+    ``cases[i]``.
+    """
+
     KIND: ClassVar[str] = "ride"
     cases: list[RideCase] = Field(min_length=1)
     design: CampaignSettings = CampaignSettings(n_starts=2)
@@ -83,6 +90,7 @@ class RideStudyConfig(ModelsStudy):
         return self
 
     def setup(self, case: RideCase) -> ModelSetup:
+        """The :class:`ModelSetup` of the ``[[models]]`` entry ``case`` names."""
         j = [m.label for m in self.models].index(case.model)
         return self.models[j].setup(f"models[{j}]")
 
@@ -116,6 +124,10 @@ def _check_case(case: RideCase, setup: ModelSetup, where: str, model: str) -> No
 # ---------------------------------------------------------------------------------------------- compute
 @dataclass(frozen=True)
 class RideResult:
+    """What the ``ride`` kind computes: ``designs`` (one row per case × design, see the module docstring),
+    ``starts`` (every multistart row of both criteria) and the FRF and PSD figure panels.
+    """
+
     config: RideStudyConfig
     designs: pd.DataFrame
     starts: pd.DataFrame
@@ -175,6 +187,12 @@ def _optimum(table: pd.DataFrame, names: list[str]) -> tuple[dict[str, float], b
 
 
 def compute(config: RideStudyConfig, context: StudyContext) -> RideResult:
+    """Both optima of every case and the three designs evaluated under both criteria and for comfort.
+
+    For each case: the minimax-sinusoid and RMS-random problems solved by multistart (the existing design, clipped
+    to the bounds, among the starts); the best successful start of each (or the best start when none succeeded);
+    then :func:`evaluate_design` for ``existing``, ``minimax_sinusoid`` and ``rms_random``.
+    """
     cfg = config
     rows, starts, frf_panels, psd_panels = [], [], [], []
     settings = cfg.design
@@ -237,6 +255,7 @@ def _log_figure(panels: list):
 
 
 def report(result: RideResult, writer: Writer) -> str:
+    """Write ``designs``, ``starts`` and the ``frf`` and ``psd`` figures; return the summary markdown."""
     cfg = result.config
     d = result.designs
     writer.table(d, "designs")

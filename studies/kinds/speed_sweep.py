@@ -32,6 +32,8 @@ __all__ = ["CriticalSpec", "SensitivitySpec", "SpeedGrid", "SpeedSweepConfig", "
 
 
 class SpeedGrid(FiniteModel):
+    """``points`` speeds evenly spaced over ``range_m_s`` (m/s, lower edge > 0)."""
+
     range_m_s: Interval
     points: int = Field(100, ge=2, le=20_000, strict=True)
 
@@ -43,6 +45,7 @@ class SpeedGrid(FiniteModel):
         return v
 
     def speeds(self) -> np.ndarray:
+        """The speeds in m/s, shape (points,), both edges included."""
         return np.linspace(*self.range_m_s, self.points)
 
 
@@ -54,6 +57,8 @@ class CriticalSpec(SpeedGrid):
 
 
 class SensitivitySpec(FiniteModel):
+    """One sensitivity table: the critical speed with ``parameter`` scaled by each of ``factors`` (> 0)."""
+
     parameter: str
     factors: list[float] = Field(min_length=1)
 
@@ -66,6 +71,11 @@ class SensitivitySpec(FiniteModel):
 
 
 class SpeedSweepConfig(ModelsStudy):
+    """The config model of the ``speed_sweep`` kind: models with a forward speed, the locus grid, the critical search.
+
+    Validation rejects a model without stability families and a sensitivity parameter the model does not have.
+    """
+
     KIND: ClassVar[str] = "speed_sweep"
     speeds: SpeedGrid
     critical: CriticalSpec
@@ -138,6 +148,12 @@ def _sensitivity_rows(cfg: SpeedSweepConfig, ref: ModelRef) -> list[dict]:
 
 
 def compute(config: SpeedSweepConfig, context: StudyContext) -> SpeedSweepResult:
+    """Root locus, least damping and spectral abscissa per speed, critical speeds and sensitivities of every model.
+
+    Critical speeds (m/s and mph) are the lowest speeds with a root in Re s > 0, bracketed on the critical grid and
+    refined by Brent to ``tol_m_s`` (§4.3.1, (4.51)–(4.59)); rigid and flexible entries of the same vehicle are
+    compared in ``track_effect``.
+    """
     cfg = config
     loci, critical, damping, sens_rows = [], [], [], []
     for i, ref in enumerate(cfg.models):
@@ -153,6 +169,7 @@ def compute(config: SpeedSweepConfig, context: StudyContext) -> SpeedSweepResult
 
 
 def report(result: SpeedSweepResult, writer: Writer) -> str:
+    """Write the locus, critical-speed, damping (and sensitivity) tables and the root-locus figure; return markdown."""
     cfg, critical_table, sens_table, track_effect = result.config, result.table, result.sensitivity, result.track_effect
     writer.table(result.locus, "root_locus")
     writer.table(critical_table, "critical_speeds")

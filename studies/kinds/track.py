@@ -67,6 +67,8 @@ class TrackTable(StrictModel):
 
 
 class FiguresTable(StrictModel):
+    """``[figures]``: which thesis figures to draw, their units (inch-pound or SI), dpi, half length (m) and points."""
+
     make: list[FigureName] = Field(default_factory=list)
     units: Literal["inch-pound", "SI"] = "inch-pound"
     dpi: int = Field(gt=20, le=300, default=100)
@@ -104,6 +106,8 @@ class TransientTable(StrictModel):
 
 
 class AmplificationTable(StrictModel):
+    """``[amplification]``: the grids of the dynamic-amplification table: v/v_cr, c/c_cr and N/N_cr ratios."""
+
     speed_ratios: list[float] = Field(
         default_factory=lambda: [0.0, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0, 1.2, 1.5]
     )
@@ -112,6 +116,12 @@ class AmplificationTable(StrictModel):
 
 
 class TrackStudyConfig(StrictModel):
+    """The config model of the ``track`` kind (thesis Ch. 3): the track, the figures and their parameter tables.
+
+    Validation requires ``study.kind = "track"``, an ``[amplification]`` table when that figure is asked for, and a
+    valid beam (EI, m, k > 0).
+    """
+
     study: StudyHeader
     track: TrackTable = Field(default_factory=TrackTable)
     figures: FiguresTable = Field(default_factory=FiguresTable)

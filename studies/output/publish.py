@@ -107,6 +107,7 @@ def check_writable(*folders: Path) -> None:
 
 
 def lock_path(results: Path, study: str) -> Path:
+    """The lock file of ``study`` under ``results``: ``results/.<study>.lock`` (see :func:`study_lock`)."""
     return results / f".{study}.lock"
 
 

@@ -33,6 +33,12 @@ __all__ = [
 
 
 class SolverOptions(StrictModel):
+    """``[design.options]``: stopping rules common to every method.
+
+    ``xtol`` (unit-cube step), ``ftol`` (relative change of the objective), ``maxeval`` (evaluations per start) and
+    ``maxtime`` (seconds per start); see :func:`railopt.design.solve.method_options`.
+    """
+
     xtol: float = Field(1e-10, gt=0, strict=True)  # strict: `true` is not a number
     ftol: float = Field(1e-12, gt=0, strict=True)
     maxeval: int = Field(3000, gt=0, strict=True)
@@ -49,10 +55,17 @@ class CampaignSettings(StrictModel):
     options: SolverOptions = SolverOptions()
 
     def solver_options(self) -> dict[str, Any]:
+        """The solver options as the plain dict the design layer takes (xtol, ftol, maxeval, maxtime)."""
         return self.options.model_dump()
 
 
 class VariableSpec(FiniteModel):
+    """A design variable: ``name`` (a parameter or alias of the model), bounds in its units, linear or log scale.
+
+    Validated by the design layer's own rules (:class:`railopt.design.DesignVariable`: lower < upper, both > 0 for
+    log), so a config fails on validation as a run would.
+    """
+
     name: str
     lower: float
     upper: float
@@ -64,6 +77,7 @@ class VariableSpec(FiniteModel):
         return self
 
     def variable(self) -> DesignVariable:
+        """The :class:`railopt.design.DesignVariable` of this entry."""
         return DesignVariable(self.name, self.lower, self.upper, self.scale)
 
 
@@ -74,6 +88,11 @@ class OutputSpec(FiniteModel):
     band_hz: BandHz
 
     def target(self, setup: ModelSetup, exact: bool) -> ResponseTarget:
+        """The peak target of this output over ``band_hz`` (converted to rad/s) on ``setup``'s family.
+
+        ``output`` defaults to the family's first output; ``exact`` selects the certified band maximum instead of the
+        thesis's maxima (4.71)–(4.73).
+        """
         output = self.output or setup.family.output_names[0]
         return ResponseTarget(output, (self.band_hz[0] * RAD_PER_HZ, self.band_hz[1] * RAD_PER_HZ), exact)
 
@@ -97,6 +116,11 @@ class SpectrumSpec(StrictModel):
         return self
 
     def spectrum(self):
+        """The track spectrum this entry describes (:func:`~railopt.models.track.spectra.irregularity_spectrum`).
+
+        Raises ValueError naming the key: a table without ``path``, ``track_class``/``level`` given for a table,
+        ``path`` given for a standard spectrum, an unreadable file or an invalid class, level or component.
+        """
         from railopt.models.track.spectra import irregularity_spectrum
 
         if self.standard == "table":
@@ -143,6 +167,7 @@ class ConstraintSpec(OutputSpec):
         return self
 
     def limit_value(self, setup: ModelSetup) -> float:
+        """The limit ε in the output's units: ``limit``, or the model's named ``clearance`` (m)."""
         return self.limit if self.limit is not None else setup.limits[self.clearance]
 
 
@@ -166,6 +191,7 @@ class StabilitySpec(FiniteModel):
     exclude: list[str] = Field(default_factory=list, description="mode names (or name prefixes) left out")
 
     def required(self, setup: ModelSetup) -> float:
+        """The required speed, m/s: ``required_speed_m_s`` or, by default, the model's maximum operating speed."""
         return self.required_speed_m_s or setup.required_speed
 
     def target(self, setup: ModelSetup, required: float | None = None) -> StabilityTarget:
@@ -219,6 +245,13 @@ class CampaignDesign(CampaignSettings):
 
 
 class ReportSpec(StrictModel):
+    """``[report]``: what the campaign report shows beyond the optima.
+
+    Named designs to ``compare`` and the one reported ``before``/after against the best optimum, the ``outputs``
+    shown (the objective by default) and those also in inches, an optional root locus over speed (m/s) before and
+    after, the ``published`` (before, after) peaks to set beside the computed ones, FRF grid points and figure dpi.
+    """
+
     compare: list[str] = Field(default_factory=list, description="named designs reported beside the optima")
     before: str | None = Field(None, description="a named design reported before/after against the best optimum")
     outputs: list[str] = Field(default_factory=list, description="outputs shown before/after (default: objective)")
@@ -270,6 +303,12 @@ class SurfaceSpec(FiniteModel):
 
 
 class CampaignStudyConfig(ModelsStudy):
+    """The config model of the ``campaign`` kind (see the module docstring).
+
+    Validation builds every model's setup and rejects what a run would (variables that are not parameters, unknown
+    outputs or named designs, start points outside the bounds, …), naming the key.
+    """
+
     KIND: ClassVar[str] = "campaign"
     objective: ObjectiveSpec
     constraints: list[ConstraintSpec] = Field(default_factory=list)
@@ -290,6 +329,7 @@ class CampaignStudyConfig(ModelsStudy):
         return self
 
     def setups(self) -> dict[str, ModelSetup]:
+        """label -> :class:`ModelSetup` of every ``[[models]]`` entry (built afresh; errors name ``models[i]``)."""
         return {m.label: m.setup(f"models[{i}]") for i, m in enumerate(self.models)}
 
 
