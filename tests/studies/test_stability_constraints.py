@@ -188,7 +188,7 @@ def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_pat
     x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
     both = problem.evaluate(x, gradient=True)
     import railopt.models.sensitivity as sensitivity
-    import railopt.models.stability as stability
+    import railopt.models.stability_rows as stability
 
     calls, maxima, roots, members = [], [], [], []
     real, real_maxima = adapter.maxima_jacobians, adapter.all_response_maxima
