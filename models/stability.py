@@ -9,6 +9,12 @@ creep damping scales as 1/S, so one assembly serves every speed and each speed c
 eigen-solve of the state matrix G (4.53).  The critical speed is the lowest S where the spectral
 abscissa ``a(S) = max_j Re s_j`` crosses zero; it is bracketed on a short grid and located by
 Brent's method on ``a(S)`` to ``tol`` m/s.  This module never imports the vehicle package.
+
+The model types are :class:`~railopt.models.protocols.SpeedFamily` and
+:class:`~railopt.models.protocols.LateralModel`.  The mode-naming vocabulary lives in
+:mod:`railopt.models.mode_names` and the stability constraint rows in :mod:`railopt.models.stability_rows`;
+their public names are re-exported here, so ``from railopt.models.stability import mode_name, StabilityRows``
+keeps working.
 """
 
 from __future__ import annotations

@@ -201,3 +201,9 @@ def read_number_table(path: str | Path, columns: tuple[str, ...]) -> tuple[np.nd
     if len(data) < 2:
         raise ValueError(f"{p}: at least two data rows are needed, got {len(data)}")
     return np.array(data), rows
+
+
+__all__ = [
+    "band", "band_arg", "forward_speeds", "frequencies_arg", "frequencies_rad_s", "number", "poisson", "positive",
+    "read_number_table", "real_array", "square_matrix",
+]

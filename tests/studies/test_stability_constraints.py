@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from railopt.design import multistart
-from railopt.models.stability import abscissa, root_constraints
+from railopt.models.stability import abscissa
+from railopt.models.stability_rows import root_constraints
 from railopt.studies.cli import STUDIES_DIR
 from railopt.studies.config import load_study
 from railopt.studies.kinds.campaign.run import campaign_problem, warnings
