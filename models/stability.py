@@ -54,33 +54,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     # the analyses
-    "CriticalSpeed",
-    "RootLocus",
-    "abscissa",
-    "critical_speed",
-    "critical_speed_gradient",
-    "first_crossing",
-    "least_damping",
-    "modes",
-    "root_locus",
-    "spectral_abscissa",
-    # re-exported: the protocols (railopt.models.protocols)
-    "LateralModel",
-    "SpeedFamily",
-    "StabilityModel",
+    "CriticalSpeed", "RootLocus", "abscissa", "critical_speed", "critical_speed_gradient", "first_crossing",
+    "least_damping", "modes", "root_locus", "spectral_abscissa",
+    # re-exported: the model types (railopt.models.protocols)
+    "LateralModel", "SpeedFamily", "StabilityModel",
     # re-exported: the mode-naming vocabulary (railopt.models.mode_names)
-    "HUNTING_COUPLING",
-    "HUNTING_DAMPING",
-    "HUNTING_LATERAL",
-    "MOTIONS",
-    "SIDES",
-    "WORDS",
-    "mode_name",
-    "readable",
+    "HUNTING_COUPLING", "HUNTING_DAMPING", "HUNTING_LATERAL", "MOTIONS", "SIDES", "WORDS", "mode_name", "readable",
     # re-exported: the stability constraint rows (railopt.models.stability_rows)
-    "StabilityRows",
-    "damping_constraints",
-    "root_constraints",
+    "StabilityRows", "damping_constraints", "root_constraints",
 ]
 
 
