@@ -311,3 +311,6 @@ def at_speed(forcing: Forcing | DistanceForcing | None, speed: float | None) -> 
                              "(m/s)")
         return forcing.at_speed(speed)
     return forcing
+
+
+__all__ = ["Amplitude", "DelayedTerm", "DistanceForcing", "Forcing", "ForcingLike", "as_forcing", "at_speed"]

@@ -84,3 +84,6 @@ def growing_roots(s: np.ndarray) -> np.ndarray:
         return s
     scale = float(np.max(np.abs(s)))
     return s[(s.real > UNDAMPED_ROOT * np.abs(s)) & (np.abs(s) > NEUTRAL_ROOT * scale)]
+
+
+__all__ = ["CONDITION_LIMIT", "Modal", "NEUTRAL_ROOT", "UNDAMPED_ROOT", "growing_roots", "modal", "mode_order"]

@@ -354,3 +354,6 @@ class ParametricSystem:
         from railopt.models.sensitivity import damped_frequency_jacobian
 
         return damped_frequency_jacobian(self.at(p, speed))
+
+
+__all__ = ["FamilyForcing", "ParameterPart", "ParametricSystem", "affine"]

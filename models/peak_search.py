@@ -262,3 +262,9 @@ def grid_maximum(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, valu
     values = fun(grid) if values is None else values
     x, f = cell_maxima(fun, grid, values, np.array([grid[0], grid[-1]]), rtol)
     return float(x[0]), float(f[0])
+
+
+__all__ = [
+    "BRACKET_RTOL", "INV_PHI", "MAX_ITERATIONS", "SCALAR_CELLS", "VERTEX_ITERATIONS", "bracketed_maximum",
+    "brent_maximum", "cell_maxima", "grid_maximum", "vertex_refine",
+]

@@ -147,3 +147,6 @@ class PoleResidue:
             H *= iw[:, None] ** self.orders[cols][None, :]
         H[~np.isfinite(H)] = np.inf
         return H
+
+
+__all__ = ["PoleResidue"]

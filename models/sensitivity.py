@@ -172,3 +172,9 @@ def damping_ratio_jacobian(s: np.ndarray, ds: np.ndarray) -> np.ndarray:
     mag = np.abs(s)[:, None]
     dmag = np.real(np.conj(s)[:, None] * ds) / mag
     return -(ds.real * mag - s.real[:, None] * dmag) / mag**2
+
+
+__all__ = [
+    "damped_frequency_jacobian", "damping_ratio_jacobian", "eigenvalue_derivatives", "maxima_jacobians",
+    "response_maxima_jacobian", "root_jacobian", "root_speed_derivative",
+]

@@ -398,3 +398,6 @@ class Tangent:
     speed: float | None = None
     dC_dspeed: np.ndarray | None = None
     dF_dspeed: object = None
+
+
+__all__ = ["DEFAULT_OUTPUT", "LinearSystem", "Output", "RESPONSE_ORDER", "SINGULAR_PIVOT", "Tangent"]

@@ -111,3 +111,9 @@ def nishihara_asami(mass_ratio: float) -> TMDTuning:
     gam = 2 / (1 + mu) * np.sqrt(2 * (16 + 23 * mu + 9 * mu**2 + 2 * (2 + mu) * r) / (3 * (64 + 80 * mu + 27 * mu**2)))
     z = 0.25 * np.sqrt((8 + 9 * mu - 4 * r) / (1 + mu))
     return TMDTuning(mu, float(gam), float(z), peak_amplification(gam, z, mu))
+
+
+__all__ = [
+    "TMDTuning", "amplification", "den_hartog", "den_hartog_fixed_point_height", "nishihara_asami",
+    "peak_amplification", "tmd_parameters", "tmd_system",
+]

@@ -40,3 +40,9 @@ def hz_to_rad_s(value):
 def rad_s_to_hz(value):
     """rad/s to Hz (scalars or arrays)."""
     return value / RAD_PER_HZ
+
+
+__all__ = [
+    "FOOT", "GRAVITY", "INCH", "KIP", "LB_PER_YARD", "MPH", "POUND_FORCE", "POUND_MASS", "PSI", "RAD_PER_HZ",
+    "hz_to_rad_s", "m_s_to_mph", "m_to_in", "n_to_lb", "rad_s_to_hz",
+]

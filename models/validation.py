@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import math
+from collections.abc import Sequence
 from numbers import Real
 from pathlib import Path
 
@@ -96,6 +97,25 @@ def frequencies_rad_s(value: object, name: str = "omega") -> np.ndarray:
     return w
 
 
+def forward_speeds(speeds: object, name: str = "speeds") -> np.ndarray:
+    """Forward speeds (m/s) as a float array (K,): one number or a sequence of positive finite numbers.
+
+    Raises
+    ------
+    ValueError
+        An empty list, or an item that is not a positive finite number (naming ``speeds[i]``; "(forward
+        speeds in m/s)" appended).
+    """
+    try:
+        items = list(speeds) if isinstance(speeds, Sequence | np.ndarray) and not isinstance(speeds, str) else [speeds]
+        values = [number(f"{name}[{i}]", s, positive=True) for i, s in enumerate(items)]
+    except ValueError as exc:
+        raise ValueError(f"{exc} (forward speeds in m/s)") from None
+    if not values:
+        raise ValueError(f"{name}: give at least one forward speed (m/s)")
+    return np.array(values)
+
+
 def positive(name: str, value: object) -> float:
     """A finite real number > 0."""
     return number(name, value, positive=True)
@@ -181,3 +201,9 @@ def read_number_table(path: str | Path, columns: tuple[str, ...]) -> tuple[np.nd
     if len(data) < 2:
         raise ValueError(f"{p}: at least two data rows are needed, got {len(data)}")
     return np.array(data), rows
+
+
+__all__ = [
+    "band", "band_arg", "forward_speeds", "frequencies_arg", "frequencies_rad_s", "number", "poisson", "positive",
+    "read_number_table", "real_array", "square_matrix",
+]

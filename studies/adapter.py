@@ -5,7 +5,7 @@ the f_k of other outputs held below a limit (ε-constraint trade-offs, g(x) ≤ 
 of SPEC §2.5 (:class:`StabilityTarget`: Re s_j + σ_min ≤ 0 for every vehicle mode at a grid of speeds up to
 the required speed, on each track's stability family; optionally ζ_j ≥ ζ_min).  Gradients are analytic:
 ``df/dx = df/dp · dp/dx`` (model Jacobian, then the parameter map of the setup); the stability rows from
-the eigenvalue sensitivities (:class:`railopt.models.stability.StabilityRows`: the members solved once, the
+the eigenvalue sensitivities (:class:`railopt.models.stability_rows.StabilityRows`: the members solved once, the
 derivatives only when the method asks).  The objective and the response constraints at one x share one
 system and one eigen-decomposition.
 
@@ -29,7 +29,7 @@ from railopt.models import LinearSystem
 from railopt.models.random_response import random_response
 from railopt.models.response_maxima import all_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
-from railopt.models.stability import StabilityRows
+from railopt.models.stability_rows import StabilityRows
 from railopt.studies.catalog import ModelSetup
 
 __all__ = ["RMSTarget", "ResponseTarget", "StabilityTarget", "minimax_problem", "rms_gradient"]

@@ -121,7 +121,7 @@ def _linfnorm_rows(reps: int) -> list[dict]:
 
 def _stability_row(reps: int) -> dict:
     """Stability constraints with gradients (root_constraints) against their floor, one eig(G) per speed."""
-    from railopt.models.stability import root_constraints
+    from railopt.models.stability_rows import root_constraints
 
     family = load_vehicle("sd40-2").lateral("rigid").family(["K2", "K3", "C13", "C15"])
     p = family.values

@@ -24,6 +24,7 @@ import sqlite3
 import sys
 import threading
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 from railopt import __version__
@@ -197,9 +198,48 @@ def _validate_vehicle(path: str) -> int:
     return _hook_output(*main_validate_vehicle(path))
 
 
-def cmd_vehicle(args: argparse.Namespace) -> int:
-    from railopt.models.vehicle.summary import main_vehicle
+class _UsageError(Exception):
+    pass
 
+
+class _VehicleParser(argparse.ArgumentParser):
+    """Argument errors come back as text (the CLI prints them), not on stderr."""
+
+    def error(self, message: str):  # noqa: D102
+        raise _UsageError(f"{self.format_usage().rstrip()}\n{self.prog}: error: {message}")
+
+
+def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
+    """``railopt vehicle NAME_OR_FILE [--speed S] [--track rigid|flexible] [--markdown]``: the report and the exit
+    code (0; 2 for a file error, with the message ``<file>: <key path>: <what>``).
+
+    ``argv`` are the arguments after ``vehicle``; ``--speed`` is the speed of the modes table in m/s (default
+    20 m/s).  Returns ``(text, code)``: the plain-text or Markdown report of
+    :func:`railopt.models.vehicle.summary.vehicle_summary` and 0; the usage and the argument error and 2; the
+    help and 0 for ``--help``; ``"railopt: error: ..."`` and 2 when the vehicle does not load.  Nothing is printed.
+    """
+    from railopt.models.vehicle.loader import load_vehicle
+    from railopt.models.vehicle.summary import vehicle_summary
+
+    parser = _VehicleParser(prog="railopt vehicle", description="Summary of a vehicle file.")
+    parser.add_argument("vehicle", help="bundled name (sd40-2, manchester-coach, single-wheelset) or a .toml file")
+    parser.add_argument("--speed", type=float, default=None, help="speed of the modes table, m/s (default 20)")
+    parser.add_argument("--track", choices=("rigid", "flexible"), default="rigid")
+    parser.add_argument("--markdown", action="store_true", help="Markdown instead of plain text")
+    try:
+        args = parser.parse_args(list(argv))
+    except _UsageError as exc:
+        return str(exc), 2
+    except SystemExit:  # --help
+        return parser.format_help(), 0
+    try:
+        summary = vehicle_summary(load_vehicle(args.vehicle), speed=args.speed, track=args.track)
+    except ValueError as exc:
+        return f"railopt: error: {exc}", 2
+    return (summary.to_markdown() if args.markdown else summary.to_text()), 0
+
+
+def cmd_vehicle(args: argparse.Namespace) -> int:
     return _hook_output(*main_vehicle(args.argv))
 
 

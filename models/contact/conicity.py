@@ -394,3 +394,9 @@ def linear_delta_r_table(conicity: float, y_max: float = 0.012, n: int = 241) ->
     y.setflags(write=False)
     d.setflags(write=False)
     return y, d
+
+
+__all__ = [
+    "NOISE_FRACTION", "NOISE_SIGMAS", "equivalent_conicity", "kinematic_wavelength", "linear_delta_r_table",
+    "noise_level", "turning_points",
+]

@@ -254,3 +254,9 @@ def creep_coefficients(
     f22 = G * math.pi * ab / psi1
     f23, f33 = johnson_spin(math.sqrt(ab), G, nu, f22)
     return CreepCoefficients(f11, f22, f23, f33).scaled(factor)
+
+
+__all__ = [
+    "CARTER_CONSTANT_SI", "CARTER_CONSTANT_US", "CreepCoefficients", "THEORIES", "Theory", "carter_coefficient",
+    "creep_coefficients", "johnson_spin", "kalker_coefficients", "vermeulen_johnson_phi_psi",
+]

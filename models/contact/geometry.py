@@ -151,3 +151,6 @@ class WheelRailGeometry:
             eps = e0 * (e0 + R_wheel * s) / (d * D)
             eta = R_rail * c * (e0 + R_wheel * s) / (d * D)
         return cls(r0=r0, e0=e0, conicity=lam, theta0=delta0, epsilon=eps, eta=eta)
+
+
+__all__ = ["WheelRailGeometry"]

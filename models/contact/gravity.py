@@ -108,3 +108,9 @@ def track_roll_terms(W: float, e0: float, K_e_roll: float, C_e_roll: float, m_e:
     return TrackRollTerms(
         inertia=0.25 * l18**2 * m, stiffness=0.5 * l18**2 * K, damping=0.5 * l18**2 * C, lateral_coupling=-W
     )
+
+
+__all__ = [
+    "TrackRollTerms", "lateral_gravity_stiffness", "lateral_track_roll_coupling", "roll_gravity_stiffness",
+    "roll_load_transfer_arm", "roll_track_roll_coupling", "track_roll_terms", "yaw_gravity_stiffness",
+]

@@ -139,3 +139,6 @@ def wheel_rail_curvatures(r_wheel: float, R_rail: float, R_wheel_transverse: flo
     if B <= 0.0:
         raise ValueError("R_wheel_transverse: must exceed R_rail (otherwise the profiles do not touch at a point)")
     return 0.5 / r_wheel, B
+
+
+__all__ = ["HertzEllipse", "hertz_coefficients", "hertz_ellipse", "wheel_rail_curvatures"]

@@ -62,3 +62,6 @@ A_OVER_B_LE_1 = _TABLES["a_le_b"]
 B_OVER_A_LE_1 = _TABLES["b_le_a"]
 NU_NODES.setflags(write=False)
 G_NODES.setflags(write=False)
+
+
+__all__ = ["A_OVER_B_LE_1", "B_OVER_A_LE_1", "COEFFICIENTS", "G_NODES", "NU_NODES"]

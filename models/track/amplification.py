@@ -77,3 +77,6 @@ def dynamic_amplification(
                     }
                 )
     return pd.DataFrame(rows)
+
+
+__all__ = ["dynamic_amplification"]

@@ -180,3 +180,6 @@ def hetenyi_deflection(x: np.ndarray | float, P: float, k: float, EI: float) -> 
     beta = (k / (4.0 * EI)) ** 0.25
     ax = beta * np.abs(np.asarray(x, dtype=float))
     return P * beta / (2.0 * k) * np.exp(-ax) * (np.cos(ax) + np.sin(ax))
+
+
+__all__ = ["Beam", "hetenyi_deflection"]

@@ -167,3 +167,6 @@ def impulse_response_at_load(
         [0.0 if ti == 0.0 else _numerical_one(beam, ti) * math.exp(-zeta * ti) for ti in t.ravel()]
     )
     return impulse * flat.reshape(t.shape)
+
+
+__all__ = ["impulse_constant", "impulse_response_at_load", "printed_impulse_constant"]

@@ -120,3 +120,6 @@ def lumped(beam: Beam, damping_ratio: float, contact_spacing: float = 1.5) -> Lu
         contact_spacing=contact_spacing,
         damping_ratio=damping_ratio,
     )
+
+
+__all__ = ["LumpedTrack", "lumped"]

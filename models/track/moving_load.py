@@ -419,3 +419,9 @@ def static_deflection(beam: Beam, x: np.ndarray | float, P: float) -> np.ndarray
     """
     x = _check_xi(x, "x")
     return closed_form_solution(beam, P, 0.0).evaluate(x)
+
+
+__all__ = [
+    "ClosedFormSolution", "MovingLoadSolution", "characteristic_roots", "closed_form_solution",
+    "fourier_deflection", "moving_load", "static_deflection",
+]

@@ -86,3 +86,9 @@ def f0_table(rail: RailSection = RAIL_132RE) -> pd.DataFrame:
                 }
             )
     return pd.DataFrame(rows)
+
+
+__all__ = [
+    "E_STEEL", "RAILS", "RAIL_115RE", "RAIL_132RE", "RailSection", "THESIS_F0", "TIE_MASS", "TIE_SPACING",
+    "TRACK_MODULUS", "f0_table", "mass_for_frequency", "tie_mass_per_rail", "wooden_tie_track",
+]

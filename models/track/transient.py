@@ -308,3 +308,6 @@ def transient(
             u = x - float(load.position(t[i]))
             y[i] += float(load.amplitude(t[i])) / (math.pi * beam.EI) * _quasi_static_tail(u, kappa_max)
     return TransientSolution(x=x, t=t, y=y, load=load, beam=beam, kappa_max=kappa_max, n_kappa=kappa.size)
+
+
+__all__ = ["DistributedImpulse", "ImpulseLoad", "Load", "MovingLoad", "SuddenLoad", "TransientSolution", "transient"]

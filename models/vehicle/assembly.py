@@ -193,3 +193,6 @@ def assemble(vehicle: Vehicle, track: str = "rigid") -> Assembly:
     T, T_in, independent = transformation(coordinates, relations, inputs)
     return Assembly(coordinates=coordinates, inputs=tuple(inputs), M=M, K0=K0, C0=C0, C_creep=C_creep, parts=parts,
                     values=values, bodies=tuple(bodies), T=T, T_in=T_in, independent=independent)
+
+
+__all__ = ["Assembly", "SuspensionMatrices", "TRACKS", "assemble", "rail_name", "track_body_name"]

@@ -64,3 +64,6 @@ class Body:
         m[:3, :3] = self.mass * np.eye(3)
         m[3:, 3:] = np.asarray(self.inertia)
         return m
+
+
+__all__ = ["Body", "KINDS"]

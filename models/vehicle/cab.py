@@ -157,3 +157,6 @@ class CabModel:
     def at(self, changes: dict[str, float] | None = None):
         """The :class:`~railopt.models.LinearSystem` at the file's values with ``changes`` applied."""
         return self.system.at(self.parameters(changes))
+
+
+__all__ = ["CabInput", "CabModel", "LATERAL", "cab_lateral_model"]

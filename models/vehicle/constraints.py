@@ -143,3 +143,6 @@ def check_reduced_mass(M: np.ndarray, names: Sequence[str]) -> None:
     bad = [n for n, m in zip(names, np.diag(M), strict=True) if not m > 0.0]
     if bad:
         raise ValueError(f"massless independent coordinates {bad}: give them inertia or constrain them")
+
+
+__all__ = ["AXES", "Relation", "check_reduced_mass", "fixed", "hinge", "rigid_tie", "transformation"]

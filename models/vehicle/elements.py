@@ -120,3 +120,6 @@ class Element:
         """``g gᵀ``: the element's contribution to K or C per unit value."""
         g = self.row(index, n)
         return np.outer(g, g)
+
+
+__all__ = ["ELEMENT_TYPES", "Element", "GROUND", "VALUE_KEYS"]

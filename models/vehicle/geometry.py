@@ -56,3 +56,6 @@ def unit(vector: np.ndarray, what: str) -> np.ndarray:
     if v.shape != (3,) or not np.isfinite(n) or n == 0.0:
         raise ValueError(f"{what}: direction must be a finite non-zero 3-vector, got {vector!r}")
     return v / n
+
+
+__all__ = ["DOFS", "LATERAL_DOFS", "THESIS_SIGNS", "VERTICAL_DOFS", "coordinate", "point_jacobian", "split", "unit"]

@@ -429,3 +429,9 @@ def _track(t: TrackSchema | None, names: Mapping[str, float]) -> TrackSpec | Non
                      rail_EI=_num(t, "rail_EI_N_m2", names, "track", positive=True),
                      mass_per_length=_num(t, "mass_per_length_kg_m", names, "track", positive=True),
                      damping_ratio=_num(t, "damping_ratio", names, "track", lower=0.0), source=t.source)
+
+
+__all__ = [
+    "BUNDLED", "INERTIA_RTOL", "MAX_DEPTH", "VehicleFileError", "bundled_path", "evaluate", "load_vehicle",
+    "parse_vehicle", "read_vehicle_file",
+]

@@ -163,3 +163,6 @@ def output_rows(view: VehicleView, outputs) -> list[OutputRow]:
     if dup:
         raise ValueError(f"outputs: repeated {dup}")
     return rows
+
+
+__all__ = ["AXES", "OutputRow", "POINT", "PointOutput", "ROTATIONS", "UNIT_SUFFIX", "output_row", "output_rows"]

@@ -264,3 +264,10 @@ def _frequencies(v: Vehicle, speed: float) -> list[PlausibilityWarning]:
                 f"{BODY_FREQUENCY_HZ[0]:g}-{BODY_FREQUENCY_HZ[1]:g} Hz: a stiffness in kN/m or a mass in tonnes?",
                 f, "body_frequency"))
     return out
+
+
+__all__ = [
+    "AXLE_LOAD_T", "BODY_FREQUENCY_HZ", "CG_HEIGHT_M", "CONICITY_MAX", "GYRATION_M", "MIN_DAMPER_N_S_PER_M",
+    "MIN_MASS_KG", "MIN_SPRING_N_PER_M", "NOMINAL_SPEED", "PlausibilityWarning", "SEMI_GAUGE_M",
+    "WHEELSET_CG_TOL_M", "WHEELSET_NAME", "WHEEL_RADIUS_M", "body_frequencies", "plausibility", "sprung_bodies",
+]

@@ -394,3 +394,12 @@ def validate_file(data: Mapping[str, Any]) -> VehicleFileSchema:
         return VehicleFileSchema.model_validate(dict(data))
     except ValidationError as exc:
         raise ValueError(format_errors(data, exc)) from None
+
+
+__all__ = [
+    "ARRAYS", "AXES", "BODY_KINDS", "BodySchema", "Bool", "CONSTRAINT_KINDS", "CREEP_MODES", "CabSchema",
+    "ConstraintSchema", "ContactSchema", "Dofs", "ELEMENT_KINDS", "ElementSchema", "HeadSchema", "Inertia",
+    "Length", "LengthSchema", "MAX_EXPRESSION", "MISSING_HINTS", "Num", "Numbers", "Str", "Strict", "TABLES",
+    "TrackSchema", "VALUE_KEYS", "Vec3", "VehicleFileSchema", "ZERO", "did_you_mean", "format_errors",
+    "item_label", "key_path", "validate_file",
+]

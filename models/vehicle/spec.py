@@ -100,3 +100,6 @@ class Lengths:
 
     values: dict[str, float] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
+
+
+__all__ = ["CONSTRAINT_TYPES", "CREEP_MODES", "ConstraintSpec", "ContactSpec", "Lengths", "TrackSpec"]

@@ -1,9 +1,9 @@
 """A one-page summary of a vehicle: masses, axle loads, CG, lateral modes, critical speeds, plausibility.
 
 :func:`vehicle_summary` returns a :class:`VehicleSummary` record; ``.to_text()`` / ``.to_markdown()``
-render it for the command line.  :func:`main_vehicle` is the whole ``railopt vehicle NAME_OR_FILE``
-command (argument list in, ``(text, exit code)`` out) and :func:`main_validate_vehicle` the vehicle
-part of ``railopt validate car.toml``, so the CLI wires each in a few lines.
+render it for the command line (the ``railopt vehicle NAME_OR_FILE`` command and its argument parsing live in
+:mod:`railopt.studies.cli`, :func:`~railopt.studies.cli.main_vehicle`); :func:`main_validate_vehicle` is the
+vehicle part of ``railopt validate car.toml``.
 
 Modes are the roots of the lateral view at the given speed (one eigen-solve), one row per mode, named by
 :func:`railopt.models.stability.modes` from the shares of the modal kinetic energy by body group
@@ -13,7 +13,6 @@ the critical speeds name their critical mode the same way.
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -173,40 +172,6 @@ def vehicle_summary(vehicle: Vehicle, speed: float | None = None, track: str = "
                           modes=modes, critical=critical, warnings=plausibility(vehicle))
 
 
-class _UsageError(Exception):
-    pass
-
-
-class _Parser(argparse.ArgumentParser):
-    """Argument errors come back as text (the CLI prints them), not on stderr."""
-
-    def error(self, message: str):  # noqa: D102
-        raise _UsageError(f"{self.format_usage().rstrip()}\n{self.prog}: error: {message}")
-
-
-def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
-    """``railopt vehicle NAME_OR_FILE [--speed S] [--track rigid|flexible] [--markdown]``: the report and the exit
-    code (0; 2 for a file error, with the message ``<file>: <key path>: <what>``)."""
-    from railopt.models.vehicle.loader import load_vehicle
-
-    parser = _Parser(prog="railopt vehicle", description="Summary of a vehicle file.")
-    parser.add_argument("vehicle", help="bundled name (sd40-2, manchester-coach, single-wheelset) or a .toml file")
-    parser.add_argument("--speed", type=float, default=None, help="speed of the modes table, m/s (default 20)")
-    parser.add_argument("--track", choices=("rigid", "flexible"), default="rigid")
-    parser.add_argument("--markdown", action="store_true", help="Markdown instead of plain text")
-    try:
-        args = parser.parse_args(list(argv))
-    except _UsageError as exc:
-        return str(exc), 2
-    except SystemExit:  # --help
-        return parser.format_help(), 0
-    try:
-        summary = vehicle_summary(load_vehicle(args.vehicle), speed=args.speed, track=args.track)
-    except ValueError as exc:
-        return f"railopt: error: {exc}", 2
-    return (summary.to_markdown() if args.markdown else summary.to_text()), 0
-
-
 def main_validate_vehicle(path: str) -> tuple[str, int]:
     """``railopt validate car.toml`` for a vehicle file: ``(text, 0)`` when it loads (plausibility warnings listed),
     ``(error, 2)`` otherwise."""
@@ -219,3 +184,6 @@ def main_validate_vehicle(path: str) -> tuple[str, int]:
     warnings = plausibility(vehicle)
     head = f"{path}: valid vehicle file ({vehicle!r})"
     return "\n".join([head] + [f"warning: {vehicle.path}: {w}" for w in warnings]) + "\n", 0
+
+
+__all__ = ["SPEED_RANGE", "TOL", "VehicleSummary", "main_validate_vehicle", "mode_table", "vehicle_summary"]

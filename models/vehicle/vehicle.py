@@ -336,3 +336,6 @@ def hertz_creep(c: ContactSpec, normal_load: float) -> Creep:
     cc = creep_coefficients(ell.a, ell.b, G, c.poisson_ratio, theory=c.theory, factor=c.creep_factor,
                             r0=c.r0, N=normal_load)
     return Creep(cc.f11, cc.f22, cc.f23, cc.f33)
+
+
+__all__ = ["CONTACT_NAMES", "CREEP_NAMES", "INERTIA_NAMES", "TRACK_NAMES", "Vehicle", "hertz_creep"]

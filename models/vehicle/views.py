@@ -270,3 +270,6 @@ class VehicleView(SuspensionMatrices):
 
 
 VehicleModel = VehicleView  # the name of earlier releases
+
+
+__all__ = ["BodyPlace", "VehicleModel", "VehicleView", "check_speed"]

@@ -183,3 +183,6 @@ def contact_matrices(
         add(K, t, v, W)  # the weight at lateral offset v - v_rail rolls the track (4.49)
         add(K, t, rv, -W)
     return K, Cc
+
+
+__all__ = ["Creep", "WheelRail", "contact_matrices"]

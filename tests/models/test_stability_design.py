@@ -8,14 +8,8 @@ import pytest
 
 from railopt.models import ParameterPart, ParametricSystem
 from railopt.models.sensitivity import root_jacobian, root_speed_derivative
-from railopt.models.stability import (
-    critical_speed,
-    critical_speed_gradient,
-    damping_constraints,
-    modes,
-    root_constraints,
-    root_locus,
-)
+from railopt.models.stability import critical_speed, critical_speed_gradient, modes, root_locus
+from railopt.models.stability_rows import damping_constraints, root_constraints
 from railopt.models.vehicle import Irregularity, load_vehicle
 
 from conftest import routh_hurwitz
@@ -191,7 +185,7 @@ def test_stability_rows_solve_once_and_give_the_asked_columns() -> None:
     """:class:`StabilityRows`: the Jacobian of any ``wrt`` is the full Jacobian's columns (any order, repeats,
     negative indices, a numpy array or a generator), the damping rows share the root derivatives, and what is not
     a list of indices is refused by name (a mask, floats, an index out of range, a bare-string exclude)."""
-    from railopt.models.stability import StabilityRows
+    from railopt.models.stability_rows import StabilityRows
 
     family = load_vehicle("sd40-2").lateral("rigid").family(["K2", "K3", "C13", "C15"])
     rows = StabilityRows(family, None, [10.0, 20.0, 30.0])

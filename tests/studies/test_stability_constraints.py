@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from railopt.design import multistart
-from railopt.models.stability import abscissa, root_constraints
+from railopt.models.stability import abscissa
+from railopt.models.stability_rows import root_constraints
 from railopt.studies.cli import STUDIES_DIR
 from railopt.studies.config import load_study
 from railopt.studies.kinds.campaign.run import campaign_problem, warnings
@@ -188,7 +189,7 @@ def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_pat
     x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
     both = problem.evaluate(x, gradient=True)
     import railopt.models.sensitivity as sensitivity
-    import railopt.models.stability as stability
+    import railopt.models.stability_rows as stability
 
     calls, maxima, roots, members = [], [], [], []
     real, real_maxima = adapter.maxima_jacobians, adapter.all_response_maxima

@@ -13,10 +13,10 @@ from railopt.models.vehicle import load_vehicle
 from railopt.models.vehicle.loader import bundled_path
 from railopt.models.vehicle.summary import (
     main_validate_vehicle,
-    main_vehicle,
     mode_table,
     vehicle_summary,
 )
+from railopt.studies.cli import main_vehicle
 
 from conftest import routh_hurwitz
 
