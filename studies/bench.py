@@ -142,6 +142,23 @@ def _stability_row(reps: int) -> dict:
             "note": f"{g.size} rows, max g = {np.max(g):.4g} 1/s"}
 
 
+def _vehicle_summary_row() -> dict:
+    """``railopt vehicle sd40-2``'s summary (modes, both critical speeds) against its two critical-speed searches."""
+    from railopt.models.vehicle.summary import SPEED_RANGE, TOL, vehicle_summary
+
+    loco = load_vehicle("sd40-2")
+    t = time.perf_counter()
+    vehicle_summary(loco, speed=25.0, track="flexible")
+    t_summary = time.perf_counter() - t
+    t = time.perf_counter()
+    for track in ("rigid", "flexible"):
+        critical_speed(loco, track=track, speed_range=SPEED_RANGE, tol=TOL)
+    t_searches = time.perf_counter() - t
+    return {"benchmark": "vehicle summary sd40-2 (railopt vehicle: masses, modes, critical speeds)",
+            "ours_s": t_summary, "reference_s": t_searches, "reference": "its two critical-speed searches alone",
+            "ratio": t_summary / t_searches, "note": "the CLI's promise: a summary in a few seconds"}
+
+
 def _random_response_row(reps: int) -> dict:
     """RMS by adaptive quadrature (a) against the modal Lyapunov covariance (b) at equal accuracy."""
     from railopt.models.random_response import rms, rms_state_space
@@ -472,6 +489,8 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
                  "reference": f"dense scan at {tol} m/s from {lo} m/s ({len(abscissa)} eigen-solves up to the "
                               "crossing)", "ratio": t_cs / t_scan,
                  "note": f"scan finds {scan_speed:.2f} m/s; |difference| {abs(scan_speed - cs.speed):.3f} m/s"})
+
+    rows.append(_vehicle_summary_row())
 
     # 6. the flagship cab model: U(x) vs the floor; SLSQP with analytic vs finite-difference gradients ------
     rows += _cab_rows(repeat)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -92,12 +91,9 @@ def test_flexible_track_modes_named_track() -> None:
 
 
 @pytest.mark.parametrize("name", ["sd40-2", "manchester-coach"])
-def test_summary_under_five_seconds(name: str) -> None:
+def test_summary_at_the_asked_speed_and_track(name: str) -> None:  # its time: `railopt bench`, not a test
     v = load_vehicle(name)
-    t = time.perf_counter()
     s = vehicle_summary(v, speed=25.0, track="flexible")
-    elapsed = time.perf_counter() - t
-    assert elapsed < 5.0
     assert s.speed == 25.0 and s.track == "flexible"
 
 
