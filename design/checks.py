@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from railopt.design.parallel import call, map_unordered
+from railopt.design.runner import Runner
 from railopt.design.store import CampaignStore
 
 Check = Callable[[np.ndarray], tuple[float, Mapping[str, Any]]]
@@ -36,7 +37,7 @@ def check_designs(
     designs: pd.DataFrame,
     variables: list[str],
     name: str,
-    client: Any = None,
+    client: Runner | None = None,
     store: CampaignStore | None = None,
 ) -> pd.DataFrame:
     """Run ``check`` on each row of ``designs`` (columns ``start_id`` and the variables).

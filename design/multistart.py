@@ -13,7 +13,8 @@ import pandas as pd
 
 from railopt.design.parallel import WorkerLost, call, map_unordered
 from railopt.design.problem import MinimaxProblem
-from railopt.design.result import SolveResult
+from railopt.design.result import SolveResult, succeeded
+from railopt.design.runner import Runner
 from railopt.design.solve import method_options, solve
 from railopt.design.starts import Start, start_points
 from railopt.design.store import CampaignStore
@@ -51,7 +52,7 @@ def batch_size(n_todo: int, workers: int, start_seconds: float) -> int:
     return int(max(1, min(MAX_BATCH, enough, balanced)))
 
 
-def _worker_threads(client: Any) -> int:
+def _worker_threads(client: Runner) -> int:
     try:
         return max(sum(client.nthreads().values()), 1)
     except Exception:  # noqa: BLE001  (a scheduler that does not answer: one start per task, as before)
@@ -82,7 +83,7 @@ def multistart(
     seed: int = 0,
     sampler: str = "sobol",
     points: Sequence[Sequence[float]] | None = None,
-    client: Any = None,
+    client: Runner | None = None,
     store: CampaignStore | None = None,
     options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
@@ -104,7 +105,8 @@ def multistart(
     sampler : {"sobol", "lhs"}
     points : sequence of designs, optional
         User starts (e.g. the existing suspension), ids 0.. before the sampled ones.
-    client : dask.distributed.Client, optional
+    client : Runner, optional
+        A dask.distributed.Client (any :class:`~railopt.design.runner.Runner`).
         Runs the starts as dask tasks (one or a batch per task, see ``batch``); ``None`` runs serially in-process.
     store : CampaignStore, optional
         Finished starts already in it are skipped (resume); new ones are committed as they finish.
@@ -208,12 +210,8 @@ def label_clusters(table: pd.DataFrame, problem: MinimaxProblem, xtol: float = 1
     """
     table = table.copy()
     names = list(problem.space.names)
-    table["success"] = (
-        (table["status"] == "converged")
-        & (table["constraint_violation"] <= 1e-6)
-        & (table["bound_violation"] <= 1e-6)
-        & np.isfinite(table["value"].to_numpy(dtype=float))
-    )
+    table["success"] = succeeded(table["status"].to_numpy(), table["constraint_violation"].to_numpy(),
+                                 table["bound_violation"].to_numpy(), table["value"].to_numpy(dtype=float))
     table["cluster"] = -1
     reps: list[np.ndarray] = []
     for idx in table[table["success"]].sort_values(["value", "start_id"]).index:

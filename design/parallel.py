@@ -42,6 +42,8 @@ from typing import Any
 
 from threadpoolctl import threadpool_limits
 
+from railopt.design.runner import Runner
+
 SCHEDULER_ENV = "RAILOPT_SCHEDULER"
 SCHEDULER_TIMEOUT_ENV = "RAILOPT_SCHEDULER_TIMEOUT"
 DASK_LOGS_ENV = "RAILOPT_DASK_LOGS"
@@ -164,7 +166,7 @@ def check_picklable(obj: Any, name: str = "") -> None:
 def map_unordered(
     fn: Callable[[Any], Any],
     items: Iterable[Any],
-    client: Any = None,
+    client: Runner | None = None,
     retries: int = 3,
     on_lost: Callable[[Any, WorkerLost], Any] | None = None,
 ) -> Iterator[Any]:
@@ -175,7 +177,8 @@ def map_unordered(
     fn : callable
         Applied to each item (on a worker when ``client`` is given).
     items : iterable
-    client : dask.distributed.Client, optional
+    client : Runner, optional
+        A dask.distributed.Client, or anything else satisfying :class:`~railopt.design.runner.Runner`; None: serial.
     retries : int
         Re-runs of a task that raised (dask's ``retries``); a task whose worker died is re-run by
         the scheduler (``distributed.scheduler.allowed-failures``).
@@ -293,14 +296,14 @@ def _result(future: Any, item: Any, info: _ClientInfo, on_lost: Callable[[Any, W
         raise _lost(info, exc) from None  # fetching the result failed: the connection
 
 
-def _address(client: Any) -> str:
+def _address(client: Runner) -> str:
     try:
         return str(client.scheduler.address)
     except Exception:
         return "the dask scheduler"
 
 
-def _workers(client: Any, timeout: float) -> dict | None:
+def _workers(client: Runner, timeout: float) -> dict | None:
     """The scheduler's workers, asked now (bounded in time); None when the scheduler does not answer."""
     try:
         identity = client.sync(client.scheduler.identity, n_workers=-1, callback_timeout=timeout)

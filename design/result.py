@@ -24,6 +24,19 @@ SUCCESS_STATUSES = frozenset({"converged"})
 FEASIBILITY_TOL = 1e-6
 
 
+def succeeded(status: Any, constraint_violation: Any, bound_violation: Any, value: Any) -> Any:
+    """The one success rule: a status in :data:`SUCCESS_STATUSES`, both violations within
+    :data:`FEASIBILITY_TOL` and a finite value.  Scalars (one solve: a bool) or equal-length arrays/columns
+    (a table of starts: a boolean array)."""
+    if isinstance(status, str):
+        return (status in SUCCESS_STATUSES and constraint_violation <= FEASIBILITY_TOL
+                and bound_violation <= FEASIBILITY_TOL and np.isfinite(value))
+    return (np.isin(np.asarray(status, dtype=object), sorted(SUCCESS_STATUSES))
+            & (np.asarray(constraint_violation, dtype=float) <= FEASIBILITY_TOL)
+            & (np.asarray(bound_violation, dtype=float) <= FEASIBILITY_TOL)
+            & np.isfinite(np.asarray(value, dtype=float)))
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class SolveResult(ArrayRecord):
     """Outcome of one local solve, re-evaluated by railopt (not trusted from the solver).
@@ -86,5 +99,5 @@ class SolveResult(ArrayRecord):
 
     @property
     def success(self) -> bool:
-        """True for a converged status with a feasible point and a finite value."""
-        return self.status in SUCCESS_STATUSES and self.feasible and np.isfinite(self.value)
+        """:func:`succeeded` of this result."""
+        return succeeded(self.status, self.constraint_violation, self.bound_violation, self.value)

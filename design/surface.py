@@ -8,13 +8,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from railopt.design.parallel import call, check_picklable, map_unordered
 from railopt.design.problem import MinimaxProblem
+from railopt.design.runner import Runner
 from railopt.records import ArrayRecord
 
 
@@ -75,7 +75,8 @@ class _Value:
 
 
 def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], names: tuple[str, str],
-             xi: Sequence[float], xj: Sequence[float], base: Sequence[float], client: Any = None) -> np.ndarray:
+             xi: Sequence[float], xj: Sequence[float], base: Sequence[float],
+             client: Runner | None = None) -> np.ndarray:
     """``fn(x)`` on the grid ``xi × xj`` of the two named variables (the others at ``base``), one task per grid
     row: an array (len(xj), len(xi), …) — ``fn`` may return a number or a vector."""
     space_names = list(space_names)
@@ -101,7 +102,7 @@ def objective_surface(
     xi: Sequence[float],
     xj: Sequence[float],
     base: Sequence[float],
-    client: Any = None,
+    client: Runner | None = None,
 ) -> Surface:
     """U over ``xi × xj`` for the two named variables, the others at ``base``; one task per grid row."""
     space = problem.space

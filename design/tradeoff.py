@@ -16,6 +16,7 @@ import pandas as pd
 
 from railopt.design.parallel import call, map_unordered
 from railopt.design.problem import MinimaxProblem
+from railopt.design.runner import Runner
 from railopt.design.solve import method_options, solve
 from railopt.design.starts import start_points
 
@@ -61,7 +62,7 @@ def epsilon_sweep(
     method: str = "slsqp",
     seed: int = 0,
     points: Sequence[Sequence[float]] | None = None,
-    client: Any = None,
+    client: Runner | None = None,
     options: dict[str, Any] | None = None,
 ) -> pd.DataFrame:
     """Minimise U s.t. g(x) ≤ ε for each ε (the problem's single constraint), multi-start each.

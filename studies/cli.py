@@ -163,9 +163,9 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 
 def _vehicle_names() -> tuple[str, ...]:
-    from railopt.models.vehicle.loader import BUNDLED
+    from railopt.models.vehicle.loader import bundled_vehicles
 
-    return tuple(BUNDLED)
+    return bundled_vehicles()
 
 
 def _hook_output(text: str, code: int) -> int:

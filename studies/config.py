@@ -227,9 +227,9 @@ names end in ``_file`` or ``_path``)."""
 
 
 def _bundled_vehicles() -> tuple[str, ...]:
-    from railopt.models.vehicle.loader import BUNDLED
+    from railopt.models.vehicle.loader import bundled_vehicles
 
-    return tuple(BUNDLED)
+    return bundled_vehicles()
 
 
 def resolve_paths(raw: dict[str, Any], folder: Path) -> dict[str, Any]:

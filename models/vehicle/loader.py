@@ -40,7 +40,22 @@ from railopt.models.vehicle.vehicle import Vehicle
 from railopt.models.vehicle.wheelrail import Creep
 from railopt.tomlfile import read_toml
 
-BUNDLED = ("sd40-2", "single-wheelset", "manchester-coach")
+_LISTED_FIRST = ("sd40-2", "single-wheelset", "manchester-coach")
+"""Listing order of the first bundled vehicles in messages (the flagship first); not a registry: a file in
+``data/`` is bundled whether or not it is named here, and a name here without its file is not."""
+
+
+def bundled_vehicles() -> tuple[str, ...]:
+    """Names of the bundled vehicles: the stems of the ``data/*.toml`` files shipped with this package (a new
+    bundled vehicle is one file there), listed in :data:`_LISTED_FIRST` order, then by name."""
+    data = resources.files("railopt.models.vehicle") / "data"
+    names = {f.name.removesuffix(".toml") for f in data.iterdir() if f.is_file() and f.name.endswith(".toml")}
+    first = {n: i for i, n in enumerate(_LISTED_FIRST)}
+    return tuple(sorted(names, key=lambda n: (first.get(n, len(first)), n)))
+
+
+BUNDLED = bundled_vehicles()
+"""The bundled vehicle names (:func:`bundled_vehicles`), read once at import."""
 MAX_DEPTH = 32  # nesting of an arithmetic expression
 INERTIA_RTOL = 1e-9  # eigenvalues of an inertia tensor below this fraction of the largest count as zero
 

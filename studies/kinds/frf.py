@@ -22,6 +22,7 @@ from railopt.studies.config import BandHz, FiniteModel
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_frf_panels
 from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.records import FrfPanel
 from railopt.studies.output.writer import Writer
 
 __all__ = ["DesignSpec", "FRFResult", "FRFStudyConfig", "GridSpec", "compute", "report"]
@@ -135,7 +136,8 @@ def _model_curves(cfg: FRFStudyConfig, i: int, ref, f_hz: np.ndarray, band: tupl
                           "grid_points": rm.grid_points, "evaluation": rm.evaluation})
             panel_curves[o].append((f"{d.label} (peak {rm.value:.6g} at {rm.argmax_frequency / HZ:.4g} Hz)",
                                     f_hz, np.abs(h), f"C{j}"))
-    panels = [(f"{ref.label}: {setup.description}", setup.axis_label(o), c) for o, c in panel_curves.items()]
+    panels = [FrfPanel.build(f"{ref.label}: {setup.description}", setup.axis_label(o), c)
+              for o, c in panel_curves.items()]
     return curves, peaks, panels
 
 

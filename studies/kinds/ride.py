@@ -42,6 +42,7 @@ from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.kinds.campaign.config import CampaignSettings, SpectrumSpec, VariableSpec
 from railopt.studies.output.figures import plot_frf_panels
 from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.records import FrfPanel
 from railopt.studies.output.writer import Writer
 
 __all__ = ["DESIGNS", "RideCase", "RideResult", "RideStudyConfig", "compute", "evaluate_design", "report"]
@@ -232,9 +233,9 @@ def compute(config: RideStudyConfig, context: StudyContext) -> RideResult:
                                ev["psd"], key))
         unit = setup.units.get(case.output, "m/s²")
         title = f"{case.label}: {setup.description.rsplit(',', 1)[0]}"
-        frf_panels.append((title, f"|{case.output}| ({unit} per m of irregularity)", frf_curves))
-        psd_panels.append((f"{title}; {case.spectrum.spectrum().label}", f"PSD of {case.output} ((m/s²)²/Hz)",
-                           psd_curves))
+        frf_panels.append(FrfPanel.build(title, f"|{case.output}| ({unit} per m of irregularity)", frf_curves))
+        psd_panels.append(FrfPanel.build(f"{title}; {case.spectrum.spectrum().label}",
+                                         f"PSD of {case.output} ((m/s²)²/Hz)", psd_curves))
     designs = pd.DataFrame(rows)
     for case in cfg.cases:  # each design under the other's criterion, relative to that criterion's optimum
         sel = designs["case"] == case.label

@@ -8,17 +8,25 @@ the wheel), distance along the track with the load at 0, ahead to the right.
 from __future__ import annotations
 
 import textwrap
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
 from railopt.models.units import INCH
+from railopt.studies.output.records import Boundary, FrfCurve, FrfPanel
+
+if TYPE_CHECKING:
+    from railopt.design import Surface
 
 __all__ = [
+    "Boundary",
     "Curve",
+    "FrfCurve",
+    "FrfPanel",
     "plot_amplification",
     "plot_before_after",
     "plot_forced_response",
@@ -183,8 +191,9 @@ def plot_amplification(
 FRF_STYLES = {"ref": ("k", "-", 2.5, 0.35), "exact": ("C0", "-", 1.3, 1.0), "thesis": ("C3", "--", 1.2, 1.0)}
 
 
-def plot_frf_panels(panels: Sequence[tuple[str, str, Sequence[tuple[str, np.ndarray, np.ndarray, str]]]]) -> Figure:
-    """One panel per (title, y label, curves); a curve is (label, frequency in Hz, |H|, style key).
+def plot_frf_panels(panels: Sequence[FrfPanel | Sequence[Any]]) -> Figure:
+    """One panel per :class:`FrfPanel` (title, y label, curves); a curve is a :class:`FrfCurve` (label,
+    frequency in Hz, |H|, style key).  Plain ``(title, ylabel, curves)`` tuples are taken as :meth:`FrfPanel.of`.
 
     Style keys: ``"ref"`` (named designs: wide grey), ``"exact"``, ``"thesis"`` (optima of the two
     objectives); any other key cycles through matplotlib's colours.  No two curves of a panel share colour and
@@ -194,9 +203,10 @@ def plot_frf_panels(panels: Sequence[tuple[str, str, Sequence[tuple[str, np.ndar
     width = 6.2
     fig = Figure(figsize=(width * len(panels), 4.6))
     axes = fig.subplots(1, len(panels), squeeze=False)[0]
-    for ax, (title, ylabel, curves) in zip(axes, panels, strict=True):
+    for ax, panel in zip(axes, map(FrfPanel.of, panels), strict=True):
+        title, ylabel = panel.title, panel.ylabel
         styles = StylePicker()
-        for i, (label, f_hz, mag, key) in enumerate(curves):
+        for i, (label, f_hz, mag, key) in enumerate((c.label, c.f_hz, c.values, c.style) for c in panel.curves):
             color, ls, lw, alpha = FRF_STYLES.get(key, (f"C{i % 10}", LINE_STYLES[i % len(LINE_STYLES)], 1.4, 1.0))
             color, ls = styles.take(color, ls)
             ax.plot(f_hz, mag, color=color, ls=ls, lw=lw, alpha=alpha, label=label)
@@ -414,14 +424,15 @@ BOUNDARY_STYLES = (("k", "--"), ("C1", ":"), ("C2", "-."), ("C4", "--"))
 MARK_STYLES = (("r", "*", 13), ("w", "X", 9), ("C1", "P", 9))
 
 
-def plot_surfaces(constrained, unconstrained, title: str, boundaries=(), marks=None,
+def plot_surfaces(constrained: Surface, unconstrained: Surface, title: str, boundaries: Sequence[Boundary] = (),
+                  marks: Mapping[str, Mapping[str, float]] | None = None,
                   units: tuple[str, str, str] = ("", "", "")) -> Figure:
     """Fig 4.18: U over two variables as 3-D surfaces and contours, constrained and unconstrained.
 
-    ``boundaries`` (label, values on the constrained grid, limit, at_least) are drawn as contours ``values = limit``
-    on the constrained contour panel, the infeasible side hatched; ``marks`` (label -> design values) are marked on
-    both contour panels (e.g. the recommended design and the unconstrained optimum).  ``units`` of the two
-    variables and of U: the axes read ``log10 <name> (<unit>)``, the value in that unit."""
+    ``boundaries`` (:class:`Boundary`: label, values on the constrained grid, limit, at_least) are drawn as contours
+    ``values = limit`` on the constrained contour panel, the infeasible side hatched; ``marks`` (label -> design
+    values) are marked on both contour panels (e.g. the recommended design and the unconstrained optimum).
+    ``units`` of the two variables and of U: the axes read ``log10 <name> (<unit>)``, the value in that unit."""
     if units is None or isinstance(units, str) or len(units) != 3:
         raise ValueError(f"units: (unit of {constrained.names[0]}, of {constrained.names[1]}, of U), got {units!r}")
 

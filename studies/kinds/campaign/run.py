@@ -28,6 +28,7 @@ from railopt.studies.kinds.campaign.config import (
     TradeoffSpec,
 )
 from railopt.studies.kinds.campaign.tradeoffs import Tradeoff, TradeoffSurfaces, surfaces, tradeoff_table
+from railopt.studies.output.records import FrfPanel
 
 __all__ = [
     "BeforeAfter",
@@ -227,7 +228,7 @@ def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], compari
             curves.append((f"{label} (peak {r['true_peak']:.6g})", f_hz,
                            np.abs(setup.family.at(p).frf(frequencies_hz=f_hz, output=target.output)),
                            r["objective"]))
-        panels.append((f"{model}: {setup.description}", setup.axis_label(target.output), curves))
+        panels.append(FrfPanel.build(f"{model}: {setup.description}", setup.axis_label(target.output), curves))
     return panels
 
 

@@ -23,6 +23,7 @@ import pandas as pd
 
 from railopt.design import MinimaxProblem, Surface, grid_map, multistart, nondominated, objective_surface
 from railopt.studies.kinds.campaign.config import SurfaceSpec, TradeoffSpec
+from railopt.studies.output.records import Boundary
 
 __all__ = ["Boundary", "Tradeoff", "TradeoffSurfaces", "distinct_designs", "surfaces", "sweep", "tradeoff_table"]
 
@@ -40,17 +41,6 @@ class Tradeoff:
     quantity: str
     required: float | None = None
     pick: pd.Series | None = None
-
-
-@dataclass(frozen=True)
-class Boundary:
-    """A constraint's value on the constrained surface grid (``values[j, i]``) and its limit: the boundary is the
-    contour ``values = limit``; feasible is ``values ≥ limit`` when ``at_least`` else ``values ≤ limit``."""
-
-    label: str
-    values: np.ndarray
-    limit: float
-    at_least: bool
 
 
 @dataclass(frozen=True)
