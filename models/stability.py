@@ -210,6 +210,7 @@ class CriticalSpeed:
 
     @property
     def stable_over_range(self) -> bool:
+        """True when no root crossed into Re s > 0 anywhere in the searched range (speed is +inf)."""
         return math.isinf(self.speed)
 
     def to_pandas(self) -> pd.DataFrame:

@@ -5,7 +5,7 @@ the f_k of other outputs held below a limit (ε-constraint trade-offs, g(x) ≤ 
 of SPEC §2.5 (:class:`StabilityTarget`: Re s_j + σ_min ≤ 0 for every vehicle mode at a grid of speeds up to
 the required speed, on each track's stability family; optionally ζ_j ≥ ζ_min).  Gradients are analytic:
 ``df/dx = df/dp · dp/dx`` (model Jacobian, then the parameter map of the setup); the stability rows from
-the eigenvalue sensitivities (:class:`railopt.models.stability_rows.StabilityRows`: the members solved once, the
+the eigenvalue sensitivities (:class:`railopt.models.stability.StabilityRows`: the members solved once, the
 derivatives only when the method asks).  The objective and the response constraints at one x share one
 system and one eigen-decomposition.
 
@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -30,9 +31,22 @@ from railopt.models.random_response import random_response
 from railopt.models.response_maxima import all_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
 from railopt.models.stability_rows import StabilityRows
+from railopt.models.units import RAD_PER_HZ
 from railopt.studies.catalog import ModelSetup
 
-__all__ = ["RMSTarget", "ResponseTarget", "StabilityTarget", "minimax_problem", "rms_gradient"]
+if TYPE_CHECKING:
+    from railopt.studies.specs import ObjectiveSpec, OutputSpec, StabilitySpec
+
+__all__ = [
+    "RMSTarget",
+    "ResponseTarget",
+    "StabilityTarget",
+    "minimax_problem",
+    "response_target",
+    "rms_gradient",
+    "rms_target",
+    "stability_target",
+]
 
 
 @dataclass(frozen=True)
@@ -238,6 +252,32 @@ class _Evaluator:
     def __getstate__(self) -> dict:  # ship to dask workers without the cached system
         return {"setup": self.setup, "names": self.names, "_key": None, "_sys": None, "_p": None, "_dp": None,
                 "_pieces": {}}
+
+
+
+# ---------------------------------------------------------------------------------------------- targets from specs
+def response_target(spec: OutputSpec, setup: ModelSetup, exact: bool) -> ResponseTarget:
+    """The f_k of ``spec.output`` (default: the family's first output) over ``spec.band_hz`` (Hz, as rad/s)."""
+    output = spec.output or setup.family.output_names[0]
+    return ResponseTarget(output, (spec.band_hz[0] * RAD_PER_HZ, spec.band_hz[1] * RAD_PER_HZ), exact)
+
+
+def rms_target(spec: ObjectiveSpec, setup: ModelSetup) -> RMSTarget:
+    """The ride objective: RMS of the output per metre of irregularity (responses divided by the model's
+    irregularity amplitude) under ``spec.spectrum`` at the model's speed over ``spec.band_hz``."""
+    output = spec.output or setup.family.output_names[0]
+    return RMSTarget(output, tuple(spec.band_hz), spec.spectrum.spectrum(), float(setup.family.speed),
+                     1.0 / setup.input_amplitude_m, spec.spectrum.rtol)
+
+
+def stability_target(spec: StabilitySpec, setup: ModelSetup, required: float | None = None) -> StabilityTarget:
+    """The stability rows of ``spec`` at ``spec.speeds`` speeds up to ``required`` (m/s; default
+    ``spec.required(setup)``)."""
+    top = required or spec.required(setup)
+    low = min(spec.lowest_speed_m_s or top / spec.speeds, top)
+    speeds = tuple(float(v) for v in np.linspace(low, top, spec.speeds))
+    return StabilityTarget(tuple(spec.tracks or setup.stability), speeds, spec.sigma_min, spec.zeta_min,
+                           tuple(spec.exclude))
 
 
 def minimax_problem(

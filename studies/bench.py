@@ -39,6 +39,7 @@ from railopt.models.stability import critical_speed
 from railopt.models.tmd import nishihara_asami
 from railopt.models.units import INCH, RAD_PER_HZ
 from railopt.models.vehicle import load_vehicle
+from railopt.studies.adapter import response_target
 from railopt.studies.config import load_study
 from railopt.studies.kinds.campaign import campaign_problem
 from railopt.studies.output.markdown import markdown_table
@@ -274,7 +275,7 @@ def _cab_rows(repeat: int) -> list[dict]:
     x0 = np.array([setup.named_designs["existing"][n] for n in names])
     p, _ = setup.parameters(names, x0)
     cab = setup.family.at(p)
-    band = config.objective.target(setup, exact=True).band
+    band = response_target(config.objective, setup, exact=True).band
     reps = max(repeat // 4, 5)
     t_floor = _floor(cab, band, reps)
     t_thesis = _median_time(lambda: _fresh(cab).response_maxima(band_rad_s=band, output="cab_acceleration"), reps)
@@ -392,7 +393,7 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
     _, config, _ = load_study(STUDIES / "tmd_hinf.toml")
     setup = config.setups()["mu0.05"]
     ps = setup.family
-    band = config.objective.target(setup, exact=True).band
+    band = response_target(config.objective, setup, exact=True).band
     na = nishihara_asami(mu)
     p, _ = setup.parameters(["tuning", "damping_ratio"], np.array([na.tuning, na.damping_ratio]))
     sys = ps.at(p)

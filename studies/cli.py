@@ -103,6 +103,7 @@ def run_timing(compute_s: float, report_s: float, context: StudyContext):
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    """``railopt run``: validate, compute and publish one study; exit code 2 on a user error."""
     study_file = resolve_study(args.study)
     kind, config, _ = load_study(study_file)
     _check_flags(args)
@@ -149,6 +150,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_list(args: argparse.Namespace) -> int:
+    """``railopt list``: the bundled studies with their kinds and descriptions."""
     import pandas as pd
 
     rows = []
@@ -176,6 +178,7 @@ def _hook_output(text: str, code: int) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    """``railopt validate``: check a study or vehicle file without running it."""
     path = Path(args.study)
     if not path.is_file() and args.study in _vehicle_names():
         return _validate_vehicle(args.study)
@@ -240,10 +243,12 @@ def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
 
 
 def cmd_vehicle(args: argparse.Namespace) -> int:
+    """``railopt vehicle``: a vehicle's summary (masses, modes, critical speeds)."""
     return _hook_output(*main_vehicle(args.argv))
 
 
 def cmd_reference(args: argparse.Namespace) -> int:
+    """``railopt reference``: the config reference (Markdown) to stdout or ``--out``."""
     from railopt.studies.reference import reference_markdown
 
     text = reference_markdown()
@@ -260,6 +265,7 @@ def cmd_reference(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
+    """``railopt bench``: the benchmark rows as ratios, written to ``results/benchmarks/``."""
     from railopt.studies.bench import run_bench
 
     run_bench(Path(args.out), workers=args.workers, quick=args.quick)
@@ -267,6 +273,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``railopt`` argument parser: run, list, validate, vehicle, reference, bench."""
     parser = argparse.ArgumentParser(prog="railopt", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"railopt {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -327,6 +334,7 @@ def _one_line(exc: BaseException) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The ``railopt`` entry point: returns the exit code (0, or 2 with one ``railopt: error:`` line)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["vehicle"]:  # its own options (--speed, --help) go to the vehicle hook, in any order
         args = argparse.Namespace(command="vehicle", func=cmd_vehicle, argv=argv[1:])

@@ -80,7 +80,7 @@ EXTENSION_POINTS = [
     "railopt.studies.kind:register_kind",
     "railopt.studies.kind:StudyContext",
     "railopt.studies.catalog:register_model",
-    "railopt.studies.catalog:Check",
+    "railopt.studies.catalog.checks:Check",
     *KIND_FUNCTIONS,
 ]
 

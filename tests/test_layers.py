@@ -127,3 +127,29 @@ def test_models_core_never_imports_the_vehicle_package() -> None:
     assert CORE, "the core modules of railopt.models were not found"
     broken = sorted((m, t) for m in CORE for t in GRAPH[m] if t.startswith("railopt.models.vehicle"))
     assert broken == []
+
+
+KINDS = "railopt.studies.kinds"
+
+
+def _kind(module: str) -> str | None:
+    """The kind a module belongs to: ``railopt.studies.kinds.<kind>[.…]`` gives ``<kind>``; other modules None."""
+    if not module.startswith(KINDS + "."):
+        return None
+    return module[len(KINDS) + 1:].split(".")[0]
+
+
+def test_kinds_never_import_other_kinds() -> None:
+    kinds = sorted({k for m in GRAPH if (k := _kind(m)) is not None})
+    assert "campaign" in kinds and "ride" in kinds, "the kind modules were not found"
+    broken = sorted((m, t) for m, targets in GRAPH.items() if _kind(m) is not None
+                    for t in targets if _kind(t) is not None and _kind(t) != _kind(m))
+    assert broken == []
+
+
+def test_configs_never_import_the_adapter() -> None:
+    configs = [m for m in GRAPH if m.startswith("railopt.studies.") and m.rsplit(".", 1)[1] in ("config", "specs")]
+    assert {"railopt.studies.config", "railopt.studies.specs", "railopt.studies.kinds.campaign.config"} <= set(configs)
+    broken = sorted((m, t) for m in configs for t in GRAPH[m]
+                    if t == "railopt.studies.adapter" or t.startswith("railopt.studies.adapter."))
+    assert broken == []

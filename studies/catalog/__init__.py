@@ -111,6 +111,7 @@ class ModelRef(StrictModel):
     options: dict[str, Any] = Field(default_factory=dict)
 
     def validated_options(self, where: str) -> BaseModel:
+        """The options validated by the catalog entry's options model; errors name ``<where>.options``."""
         entry = catalog_entry(self.model, f"{where}.model")
         try:
             return entry.options.model_validate(self.options)
@@ -118,6 +119,7 @@ class ModelRef(StrictModel):
             raise ValueError(field_errors(exc, f"{where}.options")) from None
 
     def setup(self, where: str = "models") -> ModelSetup:
+        """Build the model: its :class:`ModelSetup`; a ValueError names ``<where>.options`` or ``<where>.model``."""
         entry = catalog_entry(self.model, f"{where}.model")
         options = self.validated_options(where)  # its errors name the field already
         try:

@@ -39,11 +39,11 @@ from railopt.studies.adapter import ResponseTarget, RMSTarget, minimax_problem
 from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
 from railopt.studies.config import BandHz, FiniteModel
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
-from railopt.studies.kinds.campaign.config import CampaignSettings, SpectrumSpec, VariableSpec
 from railopt.studies.output.figures import plot_frf_panels
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.records import FrfPanel
 from railopt.studies.output.writer import Writer
+from railopt.studies.specs import CampaignSettings, SpectrumSpec, VariableSpec
 
 __all__ = ["DESIGNS", "RideCase", "RideResult", "RideStudyConfig", "compute", "evaluate_design", "report"]
 

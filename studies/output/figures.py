@@ -86,6 +86,7 @@ class StylePicker:
         self.used: set[tuple[str, str]] = set()
 
     def take(self, color: str, ls: str = "-") -> tuple[str, str]:
+        """The next unused line style of the given kind (colour and dash), so no two curves look alike."""
         candidates = [(color, ls)] + [(color, x) for x in LINE_STYLES] + \
                      [(f"C{i}", x) for x in LINE_STYLES for i in range(10)]
         for pair in candidates:

@@ -23,8 +23,8 @@ from railopt.models.track.spectra import irregularity_spectrum
 from railopt.models.vehicle import load_vehicle
 from railopt.models.vehicle.irregularity import Irregularity
 from railopt.studies.config import ConfigError, load_study
+from railopt.studies.kinds.campaign import campaign_problem
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
-from railopt.studies.kinds.campaign.run import campaign_problem
 
 ROOT = Path(__file__).resolve().parents[2]
 STUDY = ROOT / "studies" / "ride_comfort.toml"

@@ -9,9 +9,10 @@ import pytest
 from railopt.design import multistart
 from railopt.models.stability import abscissa
 from railopt.models.stability_rows import root_constraints
+from railopt.studies.adapter import stability_target
 from railopt.studies.cli import STUDIES_DIR
 from railopt.studies.config import load_study
-from railopt.studies.kinds.campaign.run import campaign_problem, warnings
+from railopt.studies.kinds.campaign import campaign_problem, warnings
 
 TWO = '''
 [[design.variables]]
@@ -59,7 +60,7 @@ def test_the_constrained_optimum_is_the_best_feasible_point_of_a_dense_grid(tmp_
     # the dense grid (100 × 100, log-spaced over the bounds): feasible where every root (none is a track mode on
     # rigid track; neutral roots aside) has Re s + σ ≤ 0 at the grid's speeds — eigenvalues alone — U there
     family = setup.stability["rigid"]
-    speeds = cfg.stability.target(setup).speeds
+    speeds = stability_target(cfg.stability, setup).speeds
     names = [v.name for v in cfg.design.variables]
     grid = [np.geomspace(v.lower, v.upper, 100) for v in cfg.design.variables]
     params = list(setup.family.parameters)
@@ -99,7 +100,7 @@ def test_every_constrained_method_takes_the_stability_rows(tmp_path, method: str
     family = setup.stability["rigid"]
     params = list(setup.family.parameters)
     p = setup.parameters(list(problem.space.names), x)[0][[params.index(n) for n in family.parameters]]
-    g_roots, _ = root_constraints(family, p, cfg.stability.target(setup).speeds, cfg.stability.sigma_min)
+    g_roots, _ = root_constraints(family, p, stability_target(cfg.stability, setup).speeds, cfg.stability.sigma_min)
     assert np.allclose(ev.g[-len(g_roots):], g_roots, rtol=0, atol=1e-12)  # the stability rows come last
     assert abs(float(np.max(g_roots))) <= 1e-6 * float(np.max(np.abs(g_roots)))  # ... and one of them is active
     lower, upper = problem.space.lower, problem.space.upper
@@ -189,7 +190,7 @@ def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_pat
     x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
     both = problem.evaluate(x, gradient=True)
     import railopt.models.sensitivity as sensitivity
-    import railopt.models.stability_rows as stability
+    import railopt.models.stability as stability
 
     calls, maxima, roots, members = [], [], [], []
     real, real_maxima = adapter.maxima_jacobians, adapter.all_response_maxima
@@ -200,8 +201,8 @@ def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_pat
     monkeypatch.setattr(stability, "eigenvalue_derivatives", lambda *a, **k: roots.append(1) or real_roots(*a, **k))
     monkeypatch.setattr(stability, "_family_rows", lambda *a, **k: members.append(1) or real_members(*a, **k))
     fresh = campaign_problem(config, setup, "exact")
-    tracks = len(config.stability.target(setup).tracks)
-    speeds = len(config.stability.target(setup).speeds)
+    tracks = len(stability_target(config.stability, setup).tracks)
+    speeds = len(stability_target(config.stability, setup).speeds)
     values = fresh.evaluate(x, gradient=False)
     # values alone: objective and two stroke peaks, the stability members solved once per track, no derivative
     assert calls == [] and len(maxima) == 3 and roots == [] and len(members) == tracks
@@ -257,7 +258,7 @@ def test_a_target_reusing_a_freed_targets_id_is_computed_afresh() -> None:
     setup = config.setups()["sd40-2"]
     names = [v.name for v in config.design.variables]
     x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
-    first = replace(config.stability.target(setup), speeds=(15.0, 20.0, 25.0), sigma_min=0.0)
+    first = replace(stability_target(config.stability, setup), speeds=(15.0, 20.0, 25.0), sigma_min=0.0)
     second = replace(first, speeds=(26.0, 28.0, 30.0), sigma_min=0.5)
     evaluator = _Evaluator(setup, names)
     stale = evaluator.stability(x, first)

@@ -11,14 +11,17 @@ evaluations, wall time, best U, true band peak at the best design, comparison wi
 ``starts.csv/.parquet``, ``optima.csv`` (distinct optima with their checks); figure ``frf.png``; with
 ``[report] before``, ``[[tradeoffs]]`` or ``[[surfaces]]`` the before/after, trade-off and surface sections.
 
-Modules: :mod:`.config` (the config), :mod:`.run` (compute), :mod:`.tradeoffs` (ε-sweeps, surfaces),
-:mod:`.report` (tables, figures, summary).
+Modules: :mod:`.config` (the config; the specs shared with other kinds are in :mod:`railopt.studies.specs`),
+:mod:`.run` (compute, warnings), :mod:`.stores` (stores and resume), :mod:`.problems` (the minimax problems),
+:mod:`.selection` (the recommended design), :mod:`.sections` (comparison, FRF panels, before/after, model
+sections), :mod:`.tradeoffs` (ε-sweeps, surfaces), :mod:`.report` (tables, figures, summary).
 """
 
 from railopt.studies.kind import StudyKind, register_kind
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
+from railopt.studies.kinds.campaign.problems import campaign_problem, design_peak
 from railopt.studies.kinds.campaign.report import report
-from railopt.studies.kinds.campaign.run import campaign_problem, compute, design_peak, warnings
+from railopt.studies.kinds.campaign.run import compute, warnings
 
 __all__ = ["KIND", "CampaignStudyConfig", "campaign_problem", "compute", "design_peak", "report"]
 

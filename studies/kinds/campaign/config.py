@@ -1,19 +1,28 @@
 """The config of the ``campaign`` kind: models, design variables, objective, constraints, methods × objectives,
 starts, checks, report, trade-offs and surfaces.  Everything a run would reject is rejected on validation
-(``railopt validate`` = ``run``); method names are those of the design registry."""
+(``railopt validate`` = ``run``); method names are those of the design registry.  The specs shared with other
+kinds (variables, objective, constraints, stability, ...) live in :mod:`railopt.studies.specs`; data only, the
+adapter's targets are made from them by :mod:`railopt.studies.adapter`."""
 
 from __future__ import annotations
 
 from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, PrivateAttr, field_validator, model_validator
 
-from railopt.design import DesignVariable
-from railopt.models.units import RAD_PER_HZ
-from railopt.studies.adapter import ResponseTarget, RMSTarget, StabilityTarget
 from railopt.studies.catalog import ModelSetup, ModelsStudy, PositiveInterval, require_unique
-from railopt.studies.config import BandHz, FiniteModel, MethodName, StrictModel
+from railopt.studies.config import FiniteModel, MethodName, StrictModel
+from railopt.studies.specs import (
+    CampaignSettings,
+    ConstraintSpec,
+    ObjectiveSpec,
+    OutputSpec,
+    SolverOptions,
+    SpectrumSpec,
+    StabilitySpec,
+    VariableSpec,
+)
 
 __all__ = [
     "CampaignDesign",
@@ -30,177 +39,6 @@ __all__ = [
     "TradeoffSpec",
     "VariableSpec",
 ]
-
-
-class SolverOptions(StrictModel):
-    """``[design.options]``: stopping rules common to every method.
-
-    ``xtol`` (unit-cube step), ``ftol`` (relative change of the objective), ``maxeval`` (evaluations per start) and
-    ``maxtime`` (seconds per start); see :func:`railopt.design.solve.method_options`.
-    """
-
-    xtol: float = Field(1e-10, gt=0, strict=True)  # strict: `true` is not a number
-    ftol: float = Field(1e-12, gt=0, strict=True)
-    maxeval: int = Field(3000, gt=0, strict=True)
-    maxtime: float = Field(120.0, gt=0, strict=True)
-
-
-class CampaignSettings(StrictModel):
-    """The ``[design]`` table shared by campaign studies."""
-
-    method: MethodName = "slsqp"
-    n_starts: int = Field(16, gt=0, strict=True)  # strict: `true` or 16.0 is not a count
-    sampler: Literal["sobol", "lhs"] = "sobol"
-    seed: int = Field(0, ge=0, strict=True)
-    options: SolverOptions = SolverOptions()
-
-    def solver_options(self) -> dict[str, Any]:
-        """The solver options as the plain dict the design layer takes (xtol, ftol, maxeval, maxtime)."""
-        return self.options.model_dump()
-
-
-class VariableSpec(FiniteModel):
-    """A design variable: ``name`` (a parameter or alias of the model), bounds in its units, linear or log scale.
-
-    Validated by the design layer's own rules (:class:`railopt.design.DesignVariable`: lower < upper, both > 0 for
-    log), so a config fails on validation as a run would.
-    """
-
-    name: str
-    lower: float
-    upper: float
-    scale: Literal["linear", "log"] = "linear"
-
-    @model_validator(mode="after")
-    def _bounds(self) -> VariableSpec:
-        DesignVariable(self.name, self.lower, self.upper, self.scale)  # same rules as the design layer
-        return self
-
-    def variable(self) -> DesignVariable:
-        """The :class:`railopt.design.DesignVariable` of this entry."""
-        return DesignVariable(self.name, self.lower, self.upper, self.scale)
-
-
-class OutputSpec(FiniteModel):
-    """An output of the model over a band (Hz)."""
-
-    output: str | None = None
-    band_hz: BandHz
-
-    def target(self, setup: ModelSetup, exact: bool) -> ResponseTarget:
-        """The peak target of this output over ``band_hz`` (converted to rad/s) on ``setup``'s family.
-
-        ``output`` defaults to the family's first output; ``exact`` selects the certified band maximum instead of the
-        thesis's maxima (4.71)–(4.73).
-        """
-        output = self.output or setup.family.output_names[0]
-        return ResponseTarget(output, (self.band_hz[0] * RAD_PER_HZ, self.band_hz[1] * RAD_PER_HZ), exact)
-
-
-class SpectrumSpec(StrictModel):
-    """``[objective.spectrum]``: the track spectrum of the ``rms`` objective
-    (:func:`railopt.models.track.spectra.irregularity_spectrum`): ``standard = "fra"`` with ``track_class`` 1–6,
-    ``"erri_b176"`` with ``level`` low/high, or ``"table"`` with ``path`` (CSV: wavenumber rad/m, PSD m²/(rad/m);
-    relative to the working directory); ``component`` profile/alignment (FRA also cross_level)."""
-
-    standard: Literal["fra", "erri_b176", "table"]
-    track_class: int | None = Field(None, strict=True)
-    level: Literal["low", "high"] | None = None
-    component: str = "profile"
-    path: str | None = None
-    rtol: float = Field(1e-8, gt=0, lt=0.1, description="relative tolerance of the RMS quadrature (variance)")
-
-    @model_validator(mode="after")
-    def _build(self) -> SpectrumSpec:
-        self.spectrum()  # its errors name the argument: track_class, level, component, path
-        return self
-
-    def spectrum(self):
-        """The track spectrum this entry describes (:func:`~railopt.models.track.spectra.irregularity_spectrum`).
-
-        Raises ValueError naming the key: a table without ``path``, ``track_class``/``level`` given for a table,
-        ``path`` given for a standard spectrum, an unreadable file or an invalid class, level or component.
-        """
-        from railopt.models.track.spectra import irregularity_spectrum
-
-        if self.standard == "table":
-            if self.path is None:
-                raise ValueError("path: a table spectrum needs the path of its CSV (wavenumber rad/m, PSD m²/(rad/m))")
-            bad = [n for n in ("track_class", "level") if getattr(self, n) is not None]
-            if bad:
-                raise ValueError(f"{bad[0]}: does not apply to a table spectrum")
-            try:
-                return irregularity_spectrum.from_table(self.path)
-            except OSError as exc:
-                raise ValueError(f"path: {exc}") from None
-        if self.path is not None:
-            raise ValueError(f"path: applies to standard = 'table' only, not {self.standard!r}")
-        return irregularity_spectrum(self.standard, track_class=self.track_class, level=self.level,
-                                     component=self.component)
-
-
-class ObjectiveSpec(OutputSpec):
-    """``[objective]``: an output over a band (Hz); with the ``rms`` objective also ``[objective.spectrum]``."""
-
-    spectrum: SpectrumSpec | None = None
-
-    def rms_target(self, setup: ModelSetup) -> RMSTarget:
-        """The ride objective: RMS of the output per metre of irregularity (responses divided by the model's
-        irregularity amplitude) under the spectrum at the model's speed over ``band_hz``."""
-        output = self.output or setup.family.output_names[0]
-        return RMSTarget(output, tuple(self.band_hz), self.spectrum.spectrum(), float(setup.family.speed),
-                         1.0 / setup.input_amplitude_m, self.spectrum.rtol)
-
-
-class ConstraintSpec(OutputSpec):
-    """f_k of ``output`` ≤ ``limit`` (units of the output), or ≤ the model's named ``clearance`` (the vehicle
-    file's ``[clearances]``, m) — the ε of ε-constraint sweeps."""
-
-    limit: float | None = Field(None, gt=0)
-    clearance: str | None = Field(None, description="a named limit of the model, e.g. secondary_lateral_m")
-    exact: bool = True
-
-    @model_validator(mode="after")
-    def _one_limit(self) -> ConstraintSpec:
-        if (self.limit is None) == (self.clearance is None):
-            raise ValueError("give exactly one of limit (a number in the output's units) or clearance (a name)")
-        return self
-
-    def limit_value(self, setup: ModelSetup) -> float:
-        """The limit ε in the output's units: ``limit``, or the model's named ``clearance`` (m)."""
-        return self.limit if self.limit is not None else setup.limits[self.clearance]
-
-
-class StabilitySpec(FiniteModel):
-    """``[stability]``: the stability constraints of the constrained problem (SPEC §2.5).
-
-    Every vehicle mode's root must satisfy Re s + σ_min ≤ 0 at ``speeds`` speeds evenly spaced from
-    ``lowest_speed_m_s`` up to the required speed (``required_speed_m_s``, default the model's maximum operating
-    speed), on each of ``tracks`` (default: every track of the model's stability families); track modes and the
-    modes named in ``exclude`` are left out; with ``zeta_min`` every kept mode is also at least that damped.
-    Each optimum's critical speeds are then confirmed by the hunting check.
-    """
-
-    speeds: int = Field(4, ge=1, le=50, strict=True)
-    lowest_speed_m_s: float | None = Field(None, gt=0, lt=1000, description="first speed of the grid (default: "
-                                           "the required speed / speeds)")
-    sigma_min: float = Field(0.0, ge=0, description="1/s")
-    zeta_min: float | None = Field(None, ge=0, lt=1)
-    required_speed_m_s: float | None = Field(None, gt=0, lt=1000)
-    tracks: list[Literal["rigid", "flexible"]] = Field(default_factory=list)
-    exclude: list[str] = Field(default_factory=list, description="mode names (or name prefixes) left out")
-
-    def required(self, setup: ModelSetup) -> float:
-        """The required speed, m/s: ``required_speed_m_s`` or, by default, the model's maximum operating speed."""
-        return self.required_speed_m_s or setup.required_speed
-
-    def target(self, setup: ModelSetup, required: float | None = None) -> StabilityTarget:
-        """The rows at ``speeds`` speeds up to ``required`` (m/s; default :meth:`required`)."""
-        top = required or self.required(setup)
-        low = min(self.lowest_speed_m_s or top / self.speeds, top)
-        speeds = tuple(float(v) for v in np.linspace(low, top, self.speeds))
-        return StabilityTarget(tuple(self.tracks or setup.stability), speeds, self.sigma_min, self.zeta_min,
-                               tuple(self.exclude))
 
 
 class CampaignDesign(CampaignSettings):
@@ -245,13 +83,7 @@ class CampaignDesign(CampaignSettings):
 
 
 class ReportSpec(StrictModel):
-    """``[report]``: what the campaign report shows beyond the optima.
-
-    Named designs to ``compare`` and the one reported ``before``/after against the best optimum, the ``outputs``
-    shown (the objective by default) and those also in inches, an optional root locus over speed (m/s) before and
-    after, the ``published`` (before, after) peaks to set beside the computed ones, FRF grid points and figure dpi.
-    """
-
+    """``[report]``: the designs compared in the tables and figures, FRF points, figure resolution."""
     compare: list[str] = Field(default_factory=list, description="named designs reported beside the optima")
     before: str | None = Field(None, description="a named design reported before/after against the best optimum")
     outputs: list[str] = Field(default_factory=list, description="outputs shown before/after (default: objective)")
@@ -303,12 +135,8 @@ class SurfaceSpec(FiniteModel):
 
 
 class CampaignStudyConfig(ModelsStudy):
-    """The config model of the ``campaign`` kind (see the module docstring).
-
-    Validation builds every model's setup and rejects what a run would (variables that are not parameters, unknown
-    outputs or named designs, start points outside the bounds, …), naming the key.
-    """
-
+    """A ``campaign`` study file: models, objective, design variables and problems, methods, stability
+    and output constraints, trade-offs, surfaces and the report (every key in docs/config-reference.md)."""
     KIND: ClassVar[str] = "campaign"
     objective: ObjectiveSpec
     constraints: list[ConstraintSpec] = Field(default_factory=list)
@@ -317,20 +145,35 @@ class CampaignStudyConfig(ModelsStudy):
     report: ReportSpec = ReportSpec()
     tradeoffs: list[TradeoffSpec] = Field(default_factory=list)
     surfaces: list[SurfaceSpec] = Field(default_factory=list)
+    _setups: dict[str, ModelSetup] | None = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _resolve(self) -> CampaignStudyConfig:
         """Everything a run would reject is rejected here (``railopt validate`` = ``run``)."""
         require_unique("design.variables", [v.name for v in self.design.variables])
+        setups = {}
         for i, ref in enumerate(self.models):
             where = f"models[{i}]"
             setup = ref.setup(where)
             _check_setup(self, setup, where)
+            setups[ref.label] = setup
+        self._setups = setups  # built once: compute uses the models validation built
         return self
 
     def setups(self) -> dict[str, ModelSetup]:
-        """label -> :class:`ModelSetup` of every ``[[models]]`` entry (built afresh; errors name ``models[i]``)."""
-        return {m.label: m.setup(f"models[{i}]") for i, m in enumerate(self.models)}
+        """The built model of each ``[[models]]`` entry by label: those built (and checked) on validation, built
+        again only for a config made without validation."""
+        if self._setups is None:
+            self._setups = {m.label: m.setup(f"models[{i}]") for i, m in enumerate(self.models)}
+        return dict(self._setups)
+
+    def __getstate__(self) -> dict[Any, Any]:
+        """Pickled (e.g. into a dask task) without the built models: a task that needs one is given its setup."""
+        state = super().__getstate__()
+        private = state.get("__pydantic_private__")
+        if private and private.get("_setups") is not None:
+            state = {**state, "__pydantic_private__": {**private, "_setups": None}}
+        return state
 
 
 def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:

@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from railopt.studies.kinds.campaign.run import BeforeAfter, CampaignResult, ModelSections
+from railopt.studies.kinds.campaign.run import CampaignResult
+from railopt.studies.kinds.campaign.sections import BeforeAfter, ModelSections
 from railopt.studies.kinds.campaign.tradeoffs import Tradeoff, TradeoffSurfaces
 from railopt.studies.output.figures import (
     plot_before_after,

@@ -1,0 +1,131 @@
+"""Problems of the ``campaign`` kind: the minimax problem of one model × objective × problem (targets made by
+:mod:`railopt.studies.adapter` from the config's specs), the design's parameters, the certified peak at a design,
+the starts, and the problems and quantities of the trade-off sweeps and surfaces."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from railopt.design import MinimaxProblem
+from railopt.studies.adapter import minimax_problem, response_target, rms_target, stability_target
+from railopt.studies.catalog import Check, ModelSetup
+from railopt.studies.kinds.campaign.config import CampaignStudyConfig, ConstraintSpec, StabilitySpec, TradeoffSpec
+
+__all__ = ["campaign_label", "campaign_problem", "design_peak"]
+
+
+def campaign_label(model: str, objective: str, method: str, problem: str = "constrained") -> str:
+    """The store name of a campaign: ``<model>-<objective>-<method>``, with ``-unconstrained`` after the model for
+    the unconstrained problem of a study that has constraints."""
+    return f"{model}-{objective}-{method}" if problem == "constrained" else f"{model}-{problem}-{objective}-{method}"
+
+
+def campaign_problem(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str, problem: str = "constrained",
+                     required_speed: float | None = None, limits: dict[int, float] | None = None) -> MinimaxProblem:
+    """The minimax problem of one model, objective kind ("thesis", "exact" or "rms": the RMS per metre under
+    ``[objective.spectrum]``) and problem: "constrained" (the config's ``[[constraints]]`` and ``[stability]``) or
+    "unconstrained" (the objective alone).  A sweep changes the required speed of the stability rows
+    (``required_speed``, m/s) or a constraint's limit (``limits``)."""
+    exact = objective == "exact"
+    variables = [v.variable() for v in cfg.design.variables]
+    target = rms_target(cfg.objective, setup) if objective == "rms" else response_target(cfg.objective, setup, exact)
+    if problem == "unconstrained":
+        return minimax_problem(setup, variables, target)
+    constraints = [response_target(c, setup, c.exact) for c in cfg.constraints]
+    values = [c.limit_value(setup) for c in cfg.constraints]
+    for i, value in (limits or {}).items():
+        values[i] = value
+    stability = None if cfg.stability is None else stability_target(cfg.stability, setup, required_speed)
+    return minimax_problem(setup, variables, target, constraints, values, stability)
+
+
+def _p(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, float]) -> np.ndarray:
+    names = [v.name for v in cfg.design.variables]
+    return setup.parameters(names, np.array([values[n] for n in names]))[0]
+
+
+def design_peak(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, float]) -> float:
+    """Certified band maximum of the objective output at a design {variable: value}."""
+    target = response_target(cfg.objective, setup, exact=True)
+    return setup.family.at(_p(cfg, setup, values)).peak(band_rad_s=target.band, exact=True, output=target.output)
+
+
+def _starts(cfg: CampaignStudyConfig, setup: ModelSetup) -> list[list[float]] | None:
+    names = [v.name for v in cfg.design.variables]
+    points = [[setup.named_designs[nm][n] for n in names] for nm in cfg.design.start_from]
+    points += [[p[n] for n in names] for p in cfg.design.points]
+    return points or None
+
+
+def _constraint_peaks(cfg: CampaignStudyConfig, setup: ModelSetup, p: np.ndarray) -> list[dict]:
+    system = setup.family.at(p)
+    return [{"output": c.output, "limit": c.limit_value(setup),
+             "peak": system.peak(band_hz=c.band_hz, exact=True, output=c.output)} for c in cfg.constraints]
+
+
+# ---------------------------------------------------------------------------------------- trade-off sweeps and surfaces
+def _sweep_problems(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str, spec: TradeoffSpec
+                    ) -> list[tuple[float, MinimaxProblem]]:
+    """The constrained problem at each target of ``spec``: the output held below ε (replacing its constraint's
+    limit, or added), the stability rows required up to the speed ε (``hunting``), or another check ≥ ε."""
+    out = []
+    for e in spec.epsilons:
+        if spec.output is not None:
+            index = next((i for i, c in enumerate(cfg.constraints) if c.output == spec.output), None)
+            if index is not None:
+                problem = campaign_problem(cfg, setup, objective, "constrained", limits={index: e})
+            else:
+                extra = ConstraintSpec(output=spec.output, band_hz=cfg.objective.band_hz, limit=e, exact=spec.exact)
+                problem = campaign_problem(cfg.model_copy(update={"constraints": [*cfg.constraints, extra]}),
+                                           setup, objective, "constrained")
+        elif spec.check == "hunting":
+            stable = cfg if cfg.stability is not None else cfg.model_copy(update={"stability": StabilitySpec()})
+            problem = campaign_problem(stable, setup, objective, "constrained", required_speed=e)
+        else:
+            check, names = setup.checks[spec.check], [v.name for v in cfg.design.variables]
+            problem = campaign_problem(cfg, setup, objective, "unconstrained").with_constraints(
+                _CheckConstraint(setup, names, check), epsilon=-e)
+        out.append((e, problem))
+    return out
+
+
+@dataclass(frozen=True)
+class _CheckConstraint:
+    """g(x) = −check value (≥ ε as −value ≤ −ε); a check stable over its whole range puts no constraint."""
+
+    setup: ModelSetup
+    names: list[str]
+    check: Check
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        value = self.check(self.setup.parameters(self.names, x)[0]).value
+        return np.array([-value if np.isfinite(value) else -1e12])
+
+
+@dataclass(frozen=True)
+class _DesignValues:
+    """Values at a design x (a task on dask): the hunting check's critical speed and the constraints' peaks."""
+
+    cfg: CampaignStudyConfig
+    setup: ModelSetup
+    hunting: bool
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        names = [v.name for v in self.cfg.design.variables]
+        p, _ = self.setup.parameters(names, np.asarray(x, dtype=float))
+        out = [self.setup.checks["hunting"](p).value] if self.hunting else []
+        return np.array(out + [c["peak"] for c in _constraint_peaks(self.cfg, self.setup, p)])
+
+
+def _quantity(cfg: CampaignStudyConfig, setup: ModelSetup, spec: TradeoffSpec):
+    names = [v.name for v in cfg.design.variables]
+
+    def value(x: np.ndarray) -> float:
+        p, _ = setup.parameters(names, x)
+        if spec.output is not None:
+            return setup.family.at(p).peak(band_hz=cfg.objective.band_hz, exact=spec.exact, output=spec.output)
+        return setup.checks[spec.check](p).value
+
+    return value

@@ -1,0 +1,231 @@
+"""Report sections of the ``campaign`` kind: the comparison rows, the FRF panels at the optima, the before/after
+of a named design against the optimum, and each model's sections (before/after, trade-offs, surfaces)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from railopt.models.stability import root_locus
+from railopt.models.units import RAD_PER_HZ as HZ
+from railopt.models.units import m_to_in
+from railopt.studies.adapter import response_target
+from railopt.studies.catalog import ModelSetup
+from railopt.studies.kinds.campaign.config import CampaignStudyConfig
+from railopt.studies.kinds.campaign.problems import (
+    _DesignValues,
+    _p,
+    _quantity,
+    _sweep_problems,
+    campaign_problem,
+    design_peak,
+)
+from railopt.studies.kinds.campaign.selection import Recommended, _active_bounds, _unconstrained_best
+from railopt.studies.kinds.campaign.tradeoffs import Tradeoff, TradeoffSurfaces, surfaces, tradeoff_table
+from railopt.studies.output.records import FrfPanel
+
+__all__ = ["BeforeAfter", "ModelSections"]
+
+
+@dataclass(frozen=True)
+class BeforeAfter:
+    """A named design against the best optimum: maxima per output, FRFs, checks and root loci."""
+
+    table: pd.DataFrame
+    thesis: float  # thesis approximation at the optimum
+    exact: float  # certified maximum at the optimum
+    active: list[str]  # active bounds at the optimum
+    frfs: list[tuple[str, np.ndarray, np.ndarray, np.ndarray, str]]  # output, f (Hz), |before|, |after|, unit
+    stability: pd.DataFrame | None
+    loci: dict[str, pd.DataFrame] | None
+
+
+@dataclass(frozen=True)
+class ModelSections:
+    """The report sections of one model: its best optimum, before/after, trade-offs and surfaces."""
+
+    model: str
+    tag: str
+    best: pd.Series | None
+    objective: str
+    before_after: BeforeAfter | None = None
+    tradeoffs: list[Tradeoff] = field(default_factory=list)
+    surfaces: list[TradeoffSurfaces] = field(default_factory=list)
+    recommended: Recommended | None = None
+    unconstrained: dict | None = None
+
+
+# ---------------------------------------------------------------------------------------------- comparison
+def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str, str],
+                    table: pd.DataFrame, optima: pd.DataFrame, flags: list[str]) -> dict:
+    names = [v.name for v in cfg.design.variables]
+    model, problem, objective, method = key
+    ok = table[table["success"]]
+    row: dict = {"model": model, "problem": problem, "objective": objective, "method": method, "starts": len(table),
+                 "converged": int(table["success"].sum()), "success_rate": float(table["success"].mean()),
+                 "distinct_optima": len(optima), "evaluations": int(table["evaluations"].sum()),
+                 "wall_time_s": float(table["wall_time"].sum())}
+    flags = [f for f in flags if f in optima.columns]  # no optima: no check columns
+    row["all_optima_pass_checks"] = bool(optima[flags].all().all()) if flags and len(optima) else None
+    # never an unstable design as the best: the best optimum is the best that passes every check
+    passing = optima[optima[flags].all(axis=1)] if flags and len(optima) else optima
+    row["failing_optima"] = len(optima) - len(passing)
+    if flags and len(optima) and len(passing) < len(optima):
+        failing = optima.drop(passing.index).sort_values("value").iloc[0]
+        row["best_failing_U"] = float(failing["value"])
+    ok = ok[ok["start_id"].isin(passing["start_id"])] if flags and len(optima) else ok
+    if len(ok):
+        best = ok.sort_values(["value", "start_id"]).iloc[0]
+        values = {n: float(best[n]) for n in names}
+        peak = design_peak(cfg, setup, values)
+        row |= {**values, "U_objective": float(best["value"]), "true_peak": peak,
+                "objective_underestimate": (peak - float(best["value"])) / peak,
+                "best_start": int(best["start_id"])}
+        for ref in cfg.report.compare:
+            ref_values = setup.named_designs[ref]
+            ref_peak = design_peak(cfg, setup, ref_values)
+            row[f"{ref}_peak"] = ref_peak
+            row[f"change_vs_{ref}"] = (peak - ref_peak) / ref_peak
+            for n in names:
+                row[f"{n}_change_vs_{ref}"] = values[n] - ref_values[n]
+        row["active_bounds"] = "; ".join(_active_bounds(cfg, values)) or "none"
+    return row
+
+
+def _short(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
+    cols = ["model", "problem", "objective", "method", *names, "U_objective", "true_peak", "converged", "starts",
+            "distinct_optima"]
+    cols += [c for c in comparison.columns if c.startswith("change_vs_")]
+    return comparison[[c for c in cols if c in comparison.columns]]
+
+
+def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], comparison: pd.DataFrame) -> list:
+    """|H| of the objective output over its band at each campaign's best design and the named designs."""
+    panels = []
+    f_hz = np.linspace(cfg.objective.band_hz[0], cfg.objective.band_hz[1], cfg.report.frf_points)
+    names = [v.name for v in cfg.design.variables]
+    for model, setup in setups.items():
+        target = response_target(cfg.objective, setup, exact=True)
+        curves = []
+        for ref in cfg.report.compare:
+            curves.append((f"{ref} (peak {design_peak(cfg, setup, setup.named_designs[ref]):.6g})", f_hz,
+                           np.abs(setup.family.at(_p(cfg, setup, setup.named_designs[ref])).frf(
+                               omega_rad_s=f_hz * HZ, output=target.output)), "ref"))
+        for _, r in comparison[comparison["model"] == model].iterrows():
+            if not np.isfinite(r.get("true_peak", np.nan)):
+                continue
+            p = _p(cfg, setup, {n: r[n] for n in names})
+            label = f"{r['problem']} {r['objective']}/{r['method']}" if len(cfg.design.problems) > 1 else \
+                f"railopt {r['objective']}/{r['method']}"
+            curves.append((f"{label} (peak {r['true_peak']:.6g})", f_hz,
+                           np.abs(setup.family.at(p).frf(frequencies_hz=f_hz, output=target.output)),
+                           r["objective"]))
+        panels.append(FrfPanel.build(f"{model}: {setup.description}", setup.axis_label(target.output), curves))
+    return panels
+
+
+# -------------------------------------------------------------------------------------- before/after and model sections
+def _check_rows(cfg: CampaignStudyConfig, setup: ModelSetup, designs: dict[str, np.ndarray]) -> pd.DataFrame | None:
+    rows = [{"design": label, "check": name, "value": (r := setup.checks[name](p)).value, **r.payload()}
+            for label, p in designs.items() for name in cfg.design.checks]
+    return pd.DataFrame(rows) if rows else None
+
+
+def _where(rm) -> str:
+    """Where a band maximum lies: "band edge" (the response still rising there) or "resonance"."""
+    k = int(np.argmax(rm.values))
+    return "band edge" if k >= len(rm.values) - 2 or rm.frequencies[k] in rm.band else "resonance"
+
+
+def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, float],
+                  band: tuple[float, float]) -> BeforeAfter:
+    """Maxima, FRFs, checks and (with forward speed) root loci of the named design ``report.before`` and the
+    optimum ``after`` (Figs 4.13–4.17)."""
+    p_before = _p(cfg, setup, setup.named_designs[cfg.report.before])
+    p_after = _p(cfg, setup, after)
+    sys_b, sys_a = setup.family.at(p_before), setup.family.at(p_after)
+    outputs = cfg.report.outputs or [response_target(cfg.objective, setup, True).output]
+    rows = []
+    for o in outputs:
+        rb = sys_b.response_maxima(band_rad_s=band, exact=True, output=o)
+        ra = sys_a.response_maxima(band_rad_s=band, exact=True, output=o)
+        row = {"output": o, "before": rb.value, "after": ra.value, "reduction_factor": rb.value / ra.value,
+               "before_at_hz": rb.argmax_frequency / HZ, "before_peak_is": _where(rb),
+               "after_at_hz": ra.argmax_frequency / HZ, "after_peak_is": _where(ra),
+               "certified": rb.certified and ra.certified}
+        if o in cfg.report.inch_outputs:
+            row |= {"before_in": m_to_in(rb.value), "after_in": m_to_in(ra.value)}  # in, in/s or in/s² by quantity
+        if o in cfg.report.published:
+            pb, pa = cfg.report.published[o]
+            row |= {"published_before": pb, "published_after": pa, "published_factor": pb / pa}
+        rows.append(row)
+    objective_output = response_target(cfg.objective, setup, True).output
+    f_hz = np.linspace(band[0] / HZ, band[1] / HZ, cfg.report.frf_points)
+    frfs = []
+    for o in outputs:
+        inch = o in cfg.report.inch_outputs
+        before = np.abs(sys_b.frf(frequencies_hz=f_hz, output=o))
+        after_h = np.abs(sys_a.frf(frequencies_hz=f_hz, output=o))
+        if inch:
+            before, after_h = m_to_in(before), m_to_in(after_h)
+        frfs.append((o, f_hz, before, after_h, setup.axis_label(o, inch=inch)))
+    loci = None
+    if cfg.report.locus_speeds_m_s is not None:
+        speeds = np.linspace(*cfg.report.locus_speeds_m_s, 80)
+        loci = {label: root_locus(setup.stability_model(p), speeds).to_pandas()
+                for label, p in (("before", p_before), ("after", p_after))}
+    thesis = sys_a.response_maxima(band_rad_s=band, exact=False, output=objective_output).value
+    return BeforeAfter(pd.DataFrame(rows), thesis,
+                       sys_a.response_maxima(band_rad_s=band, exact=True, output=objective_output).value,
+                       _active_bounds(cfg, after), frfs,
+                       _check_rows(cfg, setup, {"before": p_before, "after": p_after}), loci)
+
+
+def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, comparison: pd.DataFrame,
+                    tables: dict, tag: str, client, recommended: Recommended | None) -> ModelSections:
+    """The before/after, trade-off and surface sections of one model, at its recommended design (or, without
+    one, its best optimum passing the checks of the exact objective, or of the first objective)."""
+    names = [v.name for v in cfg.design.variables]
+    objective = "exact" if "exact" in cfg.design.objectives else cfg.design.objectives[0]
+    rows = comparison[(comparison["model"] == model) & (comparison["objective"] == objective)
+                      & (comparison["problem"] == cfg.design.problems[0])]
+    rows = rows[np.isfinite(rows["true_peak"])] if "true_peak" in rows.columns else rows.iloc[0:0]
+    if rows.empty and recommended is None:
+        return ModelSections(model, tag, None, objective)
+    best = rows.sort_values("true_peak").iloc[0] if len(rows) else None
+    after = dict(recommended.values) if recommended is not None else {n: float(best[n]) for n in names}
+    if best is None or recommended is not None:
+        best = pd.Series({**after, "true_peak": recommended.U, **recommended.source})
+    band = response_target(cfg.objective, setup, exact=True).band
+    before_after = _before_after(cfg, setup, after, band) if cfg.report.before else None
+    starts = pd.concat([t for (m, _, o, _), t in tables.items() if m == model])
+    x_after = np.array([after[n] for n in names])
+    tradeoffs = []
+    for spec in cfg.tradeoffs:
+        required = None
+        if spec.check == "hunting":
+            required = (cfg.stability.required(setup) if cfg.stability is not None else setup.required_speed)
+        elif spec.output is not None:
+            limits = [c.limit_value(setup) for c in cfg.constraints if c.output == spec.output]
+            required = limits[0] if limits else None
+        tradeoffs.append(tradeoff_table(
+            spec, _sweep_problems(cfg, setup, objective, spec), starts, _quantity(cfg, setup, spec),
+            lambda x: design_peak(cfg, setup, dict(zip(names, x, strict=True))), cfg.design.seed,
+            points=[list(x_after)], client=client, required=required))
+    reference = _unconstrained_best(cfg, setup, model, tables)
+    marks = {"recommended" if recommended is not None else "optimum": after}
+    if reference is not None:
+        marks["unconstrained optimum"] = reference["values"]
+    hunting = "hunting" in setup.checks and bool(setup.stability)
+    limits = ([("critical speed (m/s) = required", (cfg.stability.required(setup) if cfg.stability is not None
+                                                    else setup.required_speed), True)] if hunting else [])
+    limits += [(f"{c.output} ({setup.units[c.output]}) = limit" if setup.units.get(c.output) else f"{c.output} = limit",
+                c.limit_value(setup), False) for c in cfg.constraints]
+    problem = campaign_problem(cfg, setup, objective, "unconstrained")
+    u_unit = setup.units.get(cfg.objective.output or setup.family.output_names[0], "")
+    grids = [surfaces(problem, spec, x_after, client, _DesignValues(cfg, setup, hunting), limits, marks,
+                      units=(*(setup.parameter_map.unit(v) for v in spec.variables), u_unit))
+             for spec in cfg.surfaces]
+    return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids, recommended, reference)

@@ -1,0 +1,163 @@
+"""The config specs shared by study kinds (pydantic models only, data without runtime objects): the
+``[design]`` settings and solver options, design variables, outputs over a band, the objective and its track
+spectrum, constraints and the stability constraints.  Kinds build their configs from these; the targets the design
+layer runs are made from them by :mod:`railopt.studies.adapter` (``response_target``, ``rms_target``,
+``stability_target``), which configs never import."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Literal
+
+from pydantic import Field, model_validator
+
+from railopt.design import DesignVariable
+from railopt.studies.config import BandHz, FiniteModel, MethodName, StrictModel
+
+if TYPE_CHECKING:
+    from railopt.studies.catalog import ModelSetup
+
+__all__ = [
+    "CampaignSettings",
+    "ConstraintSpec",
+    "ObjectiveSpec",
+    "OutputSpec",
+    "SolverOptions",
+    "SpectrumSpec",
+    "StabilitySpec",
+    "VariableSpec",
+]
+
+
+class SolverOptions(StrictModel):
+    """``[design.options]``: the solver's tolerances, evaluation and time limits."""
+
+    xtol: float = Field(1e-10, gt=0, strict=True)  # strict: `true` is not a number
+    ftol: float = Field(1e-12, gt=0, strict=True)
+    maxeval: int = Field(3000, gt=0, strict=True)
+    maxtime: float = Field(120.0, gt=0, strict=True)
+
+
+class CampaignSettings(StrictModel):
+    """The ``[design]`` table shared by campaign studies."""
+
+    method: MethodName = "slsqp"
+    n_starts: int = Field(16, gt=0, strict=True)  # strict: `true` or 16.0 is not a count
+    sampler: Literal["sobol", "lhs"] = "sobol"
+    seed: int = Field(0, ge=0, strict=True)
+    options: SolverOptions = SolverOptions()
+
+    def solver_options(self) -> dict[str, Any]:
+        """The solver options as keyword arguments of the design layer."""
+        return self.options.model_dump()
+
+
+class VariableSpec(FiniteModel):
+    """A design variable: a designable parameter of the model, its bounds and its scale."""
+
+    name: str
+    lower: float
+    upper: float
+    scale: Literal["linear", "log"] = "linear"
+
+    @model_validator(mode="after")
+    def _bounds(self) -> VariableSpec:
+        DesignVariable(self.name, self.lower, self.upper, self.scale)  # same rules as the design layer
+        return self
+
+    def variable(self) -> DesignVariable:
+        """The design layer's variable."""
+        return DesignVariable(self.name, self.lower, self.upper, self.scale)
+
+
+class OutputSpec(FiniteModel):
+    """An output of the model over a band (Hz)."""
+
+    output: str | None = None
+    band_hz: BandHz
+
+
+class SpectrumSpec(StrictModel):
+    """``[objective.spectrum]``: the track spectrum of the ``rms`` objective
+    (:func:`railopt.models.track.spectra.irregularity_spectrum`): ``standard = "fra"`` with ``track_class`` 1–6,
+    ``"erri_b176"`` with ``level`` low/high, or ``"table"`` with ``path`` (CSV: wavenumber rad/m, PSD m²/(rad/m);
+    relative to the working directory); ``component`` profile/alignment (FRA also cross_level)."""
+
+    standard: Literal["fra", "erri_b176", "table"]
+    track_class: int | None = Field(None, strict=True)
+    level: Literal["low", "high"] | None = None
+    component: str = "profile"
+    path: str | None = None
+    rtol: float = Field(1e-8, gt=0, lt=0.1, description="relative tolerance of the RMS quadrature (variance)")
+
+    @model_validator(mode="after")
+    def _build(self) -> SpectrumSpec:
+        self.spectrum()  # its errors name the argument: track_class, level, component, path
+        return self
+
+    def spectrum(self):
+        """The track spectrum the spec names."""
+        from railopt.models.track.spectra import irregularity_spectrum
+
+        if self.standard == "table":
+            if self.path is None:
+                raise ValueError("path: a table spectrum needs the path of its CSV (wavenumber rad/m, PSD m²/(rad/m))")
+            bad = [n for n in ("track_class", "level") if getattr(self, n) is not None]
+            if bad:
+                raise ValueError(f"{bad[0]}: does not apply to a table spectrum")
+            try:
+                return irregularity_spectrum.from_table(self.path)
+            except OSError as exc:
+                raise ValueError(f"path: {exc}") from None
+        if self.path is not None:
+            raise ValueError(f"path: applies to standard = 'table' only, not {self.standard!r}")
+        return irregularity_spectrum(self.standard, track_class=self.track_class, level=self.level,
+                                     component=self.component)
+
+
+class ObjectiveSpec(OutputSpec):
+    """``[objective]``: an output over a band (Hz); with the ``rms`` objective also ``[objective.spectrum]``."""
+
+    spectrum: SpectrumSpec | None = None
+
+
+class ConstraintSpec(OutputSpec):
+    """f_k of ``output`` ≤ ``limit`` (units of the output), or ≤ the model's named ``clearance`` (the vehicle
+    file's ``[clearances]``, m) — the ε of ε-constraint sweeps."""
+
+    limit: float | None = Field(None, gt=0)
+    clearance: str | None = Field(None, description="a named limit of the model, e.g. secondary_lateral_m")
+    exact: bool = True
+
+    @model_validator(mode="after")
+    def _one_limit(self) -> ConstraintSpec:
+        if (self.limit is None) == (self.clearance is None):
+            raise ValueError("give exactly one of limit (a number in the output's units) or clearance (a name)")
+        return self
+
+    def limit_value(self, setup: ModelSetup) -> float:
+        """The limit in the output's units: ``limit``, or the model's named clearance."""
+        return self.limit if self.limit is not None else setup.limits[self.clearance]
+
+
+class StabilitySpec(FiniteModel):
+    """``[stability]``: the stability constraints of the constrained problem (SPEC §2.5).
+
+    Every vehicle mode's root must satisfy Re s + σ_min ≤ 0 at ``speeds`` speeds evenly spaced from
+    ``lowest_speed_m_s`` up to the required speed (``required_speed_m_s``, default the model's maximum operating
+    speed), on each of ``tracks`` (default: every track of the model's stability families); track modes and the
+    modes named in ``exclude`` are left out; with ``zeta_min`` every kept mode is also at least that damped.
+    Each optimum's critical speeds are then confirmed by the hunting check.
+    """
+
+    speeds: int = Field(4, ge=1, le=50, strict=True)
+    lowest_speed_m_s: float | None = Field(None, gt=0, lt=1000, description="first speed of the grid (default: "
+                                           "the required speed / speeds)")
+    sigma_min: float = Field(0.0, ge=0, description="1/s")
+    zeta_min: float | None = Field(None, ge=0, lt=1)
+    required_speed_m_s: float | None = Field(None, gt=0, lt=1000)
+    tracks: list[Literal["rigid", "flexible"]] = Field(default_factory=list)
+    exclude: list[str] = Field(default_factory=list, description="mode names (or name prefixes) left out")
+
+    def required(self, setup: ModelSetup) -> float:
+        """The required speed (m/s): ``required_speed_m_s``, or the model's maximum operating speed."""
+        return self.required_speed_m_s or setup.required_speed
