@@ -190,16 +190,16 @@ def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_pat
     x = np.array([3.0e5, 1.0e8, 8.0e4, 5.0e4])
     both = problem.evaluate(x, gradient=True)
     import railopt.models.sensitivity as sensitivity
-    import railopt.models.stability as stability
+    import railopt.models.stability_rows as rows_module
 
     calls, maxima, roots, members = [], [], [], []
     real, real_maxima = adapter.maxima_jacobians, adapter.all_response_maxima
-    real_roots, real_members = stability.eigenvalue_derivatives, stability._family_rows
+    real_roots, real_members = rows_module.eigenvalue_derivatives, rows_module._family_rows
     monkeypatch.setattr(adapter, "maxima_jacobians", lambda *a, **k: calls.append(1) or real(*a, **k))
     for module in (adapter, sensitivity):
         monkeypatch.setattr(module, "all_response_maxima", lambda *a, **k: maxima.append(1) or real_maxima(*a, **k))
-    monkeypatch.setattr(stability, "eigenvalue_derivatives", lambda *a, **k: roots.append(1) or real_roots(*a, **k))
-    monkeypatch.setattr(stability, "_family_rows", lambda *a, **k: members.append(1) or real_members(*a, **k))
+    monkeypatch.setattr(rows_module, "eigenvalue_derivatives", lambda *a, **k: roots.append(1) or real_roots(*a, **k))
+    monkeypatch.setattr(rows_module, "_family_rows", lambda *a, **k: members.append(1) or real_members(*a, **k))
     fresh = campaign_problem(config, setup, "exact")
     tracks = len(stability_target(config.stability, setup).tracks)
     speeds = len(stability_target(config.stability, setup).speeds)
