@@ -26,6 +26,7 @@ import re
 import shutil
 import socket
 import sys
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 from pathlib import Path
@@ -143,6 +144,12 @@ def study_lock(results: Path, study: str) -> Iterator[Path]:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             holder = _holder(fd)
+            # the holder writes its line right after taking the lock: a blank line is a holder a moment old
+            for _ in range(50):
+                if holder:
+                    break
+                time.sleep(0.02)
+                holder = _holder(fd)
             os.close(fd)
             raise StudyLocked(
                 f"results: study {study!r} is being run by {_describe(holder)} (lock {path}); "

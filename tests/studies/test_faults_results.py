@@ -278,6 +278,27 @@ def test_a_live_holder_of_the_study_lock_is_named(published, results):
     assert {k: v for k, v in snapshot(results).items() if k != lock_file.name} == before
 
 
+def test_a_holder_that_has_locked_but_not_yet_written_its_line_is_still_named(tmp_path):
+    """The window between the holder's ``flock`` and its line (the race two runs started at once hit): the
+    refused run waits for the line instead of reporting an anonymous holder."""
+    import fcntl
+    import threading
+
+    from railopt.studies.output.publish import StudyLocked, study_lock
+
+    path = lock_path(tmp_path, STUDY)
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # locked, line not yet written
+    writer = threading.Timer(0.2, lambda: os.write(fd, b"4242 somehost 2026-12-02T00:00:00+00:00\n"))
+    writer.start()
+    try:
+        with pytest.raises(StudyLocked, match="PID 4242 on host somehost"), study_lock(tmp_path, STUDY):
+            pass
+    finally:
+        writer.join()
+        os.close(fd)
+
+
 def test_a_stale_lock_of_a_dead_process_is_taken_over(published, results):
     study, _ = published
     pid = dead_pid()
