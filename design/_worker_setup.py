@@ -15,3 +15,6 @@ def dask_setup(worker: object = None) -> None:
     """Ignore SIGINT in this worker process (only possible from its main thread, where dask runs it)."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+__all__ = ["dask_setup"]

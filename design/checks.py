@@ -58,3 +58,6 @@ def check_designs(
         rows.append({"start_id": start_id, "name": name, "value": value, **payload})
     return pd.DataFrame(rows).sort_values("start_id", ignore_index=True) if rows else pd.DataFrame(
         columns=["start_id", "name", "value"])
+
+
+__all__ = ["Check", "check_designs"]

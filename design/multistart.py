@@ -235,3 +235,8 @@ def distinct_optima(table: pd.DataFrame, problem: MinimaxProblem) -> pd.DataFram
         rows.append({"cluster": int(k), "value": best["value"], "count": len(grp),
                      "best_start": int(best["start_id"]), **{n: best[n] for n in names}})
     return pd.DataFrame(rows, columns=["cluster", "value", "count", "best_start", *names])
+
+
+__all__ = [
+    "MAX_BATCH", "TASKS_PER_WORKER", "TASK_SECONDS", "batch_size", "distinct_optima", "label_clusters", "multistart",
+]

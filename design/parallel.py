@@ -503,3 +503,10 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     ):
         _CLIENTS[client] = _ClientInfo(str(cluster.scheduler_address), wait, False)
         yield client
+
+
+__all__ = [
+    "DASK_LOGS_ENV", "DEFAULT_SCHEDULER_TIMEOUT", "LOCAL_NO_WORKERS_LIMIT", "SCHEDULER_ENV", "SCHEDULER_MARGIN",
+    "SCHEDULER_TIMEOUT_ENV", "SchedulerError", "WorkerLost", "call", "check_picklable", "dask_client",
+    "map_unordered", "scheduler_timeout",
+]

@@ -233,3 +233,6 @@ class MinimaxProblem:
         if J.shape != (m, self.space.dim):
             raise ValueError(f"{field}: must return shape ({m}, {self.space.dim}), got {J.shape}")
         return J
+
+
+__all__ = ["Evaluation", "MinimaxProblem", "VectorFunction"]

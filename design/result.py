@@ -101,3 +101,6 @@ class SolveResult(ArrayRecord):
     def success(self) -> bool:
         """:func:`succeeded` of this result."""
         return succeeded(self.status, self.constraint_violation, self.bound_violation, self.value)
+
+
+__all__ = ["FEASIBILITY_TOL", "STATUSES", "SUCCESS_STATUSES", "SolveResult", "succeeded"]

@@ -121,3 +121,6 @@ def _result(problem: MinimaxProblem, x0: np.ndarray, x: np.ndarray, ev: Evaluati
         bound_violation=problem.space.bound_violation(x),
         functions=ev.f if ev is not None else np.zeros(0),
     )
+
+
+__all__ = ["MAX_EVAL", "method_options", "solve"]

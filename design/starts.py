@@ -85,3 +85,6 @@ def check_seed(seed: object) -> int:
     if seed > MAX_SEED:
         raise ValueError(f"seed: {seed} does not fit in a signed 64-bit integer (at most 2**63 - 1 = {MAX_SEED})")
     return int(seed)
+
+
+__all__ = ["MAX_SEED", "MAX_STARTS", "SAMPLERS", "Start", "check_count", "check_seed", "start_points"]

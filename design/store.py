@@ -426,3 +426,9 @@ class CampaignStore:
             df = pd.read_sql_query("SELECT * FROM checks ORDER BY start_id, name", self._db)
         df["payload"] = [json.loads(s) for s in df.pop("payload_json")]
         return df
+
+
+__all__ = [
+    "BUSY_TIMEOUT", "RETRYABLE_STATUSES", "SCHEMA_VERSION", "TABLES", "CampaignStore", "DuplicateStart",
+    "StoreDamaged", "StoreError", "config_hash",
+]

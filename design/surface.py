@@ -112,3 +112,6 @@ def objective_surface(
     inside_i = (xi >= space.lower[i]) & (xi <= space.upper[i])
     inside_j = (xj >= space.lower[j]) & (xj <= space.upper[j])
     return Surface(names, xi, xj, values, inside_j[:, None] & inside_i[None, :])
+
+
+__all__ = ["Surface", "grid_map", "objective_surface"]

@@ -88,3 +88,6 @@ def minimax_test_problems(analytic: bool = True) -> dict[str, TestProblem]:
         "Rosen-Suzuki": _make("Rosen-Suzuki", _rosen_suzuki, 4, [0, 0, 0, 0], -44.0, [0, 1, 2, -1],
                               analytic=analytic),
     }
+
+
+__all__ = ["TestProblem", "minimax_test_problems"]

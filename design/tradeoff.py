@@ -92,3 +92,6 @@ def epsilon_sweep(
                     **dict(zip(problem.space.names, r.x, strict=True))}
         rows.append(row)
     return pd.DataFrame(rows, columns=["epsilon", "value", "g", "status", "success", *problem.space.names])
+
+
+__all__ = ["epsilon_sweep", "nondominated"]

@@ -115,3 +115,6 @@ class Space:
             bad = [n for n, xi, lo, hi in zip(self.names, x, self.lower, self.upper, strict=True) if not lo <= xi <= hi]
             raise ValueError(f"{field}: outside the bounds for {bad}")
         return np.clip(x, self.lower, self.upper)  # within the 1e-12 tolerance: onto the bound, never past it
+
+
+__all__ = ["SCALES", "DesignVariable", "Space"]

@@ -61,3 +61,6 @@ class ArrayRecord:
         fields = [f for f in dataclasses.fields(self) if f.repr]  # type: ignore[arg-type]
         inner = ", ".join(f"{f.name}={_short(getattr(self, f.name))}" for f in fields)
         return f"{type(self).__name__}({inner})"
+
+
+__all__ = ["ArrayRecord"]

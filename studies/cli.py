@@ -46,7 +46,10 @@ from railopt.studies.output.publish import (
 )
 from railopt.studies.output.writer import Writer
 
-__all__ = ["STUDIES_DIR", "build_parser", "main", "print_warnings", "resolve_study"]
+__all__ = [
+    "STUDIES_DIR", "build_parser", "cmd_bench", "cmd_list", "cmd_reference", "cmd_run", "cmd_validate",
+    "cmd_vehicle", "main", "main_vehicle", "print_warnings", "resolve_study", "run_timing",
+]
 
 STUDIES_DIR = Path(__file__).resolve().parent
 EXIT_USAGE = 2

@@ -101,3 +101,31 @@ def test_public_definitions_have_docstrings():
     missing = sorted(name for name, ok in everything.items() if not ok)
     assert not missing, (f"{len(missing)} of {len(everything)} public definitions without a docstring:\n"
                          + "\n".join(missing))
+
+
+def _all_names(tree: ast.Module) -> list[str] | None:
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets):
+            return [ast.literal_eval(e) for e in node.value.elts]
+    return None
+
+
+def test_one_all_convention_every_module_lists_its_public_definitions() -> None:
+    """The ``__all__`` convention: every module that defines a public ``def``/``class`` declares ``__all__`` as
+    one literal list; it names each of them, and each name it lists is bound in the module (a face module also
+    lists the names it re-exports)."""
+    import importlib
+
+    missing, unlisted, unbound = [], [], []
+    for module, path in MODULES.items():
+        tree = ast.parse(path.read_text(), str(path))
+        defined = [n.name for n in tree.body if isinstance(n, DEFS) and not n.name.startswith("_")]
+        listed = _all_names(tree)
+        if listed is None:
+            if defined:
+                missing.append(module)
+            continue
+        unlisted += [f"{module}.{name}" for name in defined if name not in listed]
+        loaded = importlib.import_module(module)
+        unbound += [f"{module}.{name}" for name in listed if not hasattr(loaded, name)]
+    assert (missing, unlisted, unbound) == ([], [], [])

@@ -145,3 +145,6 @@ def register(method: Method) -> Method:
     """
     METHODS[method.name] = method
     return method
+
+
+__all__ = ["BIG", "COMMON_OPTIONS", "METHODS", "EpigraphView", "Method", "Outcome", "StopSolve", "register"]

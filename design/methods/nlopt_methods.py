@@ -105,3 +105,6 @@ class NloptMethod:
 
 register(NloptMethod("slsqp", "LD_SLSQP", uses_gradient=True))
 register(NloptMethod("cobyla", "LN_COBYLA", uses_gradient=False, defaults={"initial_step": 0.05}))
+
+
+__all__ = ["NloptMethod"]

@@ -101,3 +101,6 @@ class SLPMethod:
 
 
 register(SLPMethod())
+
+
+__all__ = ["SLPMethod"]

@@ -447,6 +447,6 @@ def _track(t: TrackSchema | None, names: Mapping[str, float]) -> TrackSpec | Non
 
 
 __all__ = [
-    "BUNDLED", "INERTIA_RTOL", "MAX_DEPTH", "VehicleFileError", "bundled_path", "evaluate", "load_vehicle",
-    "parse_vehicle", "read_vehicle_file",
+    "BUNDLED", "INERTIA_RTOL", "MAX_DEPTH", "VehicleFileError", "bundled_path", "bundled_vehicles", "evaluate",
+    "load_vehicle", "parse_vehicle", "read_vehicle_file",
 ]

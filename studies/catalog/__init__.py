@@ -13,12 +13,13 @@ validated by a pydantic model, so ``railopt validate`` catches what a run would 
 from __future__ import annotations
 
 import importlib
+import json
 import pkgutil
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Annotated, Any, ClassVar
 
-from pydantic import AfterValidator, BaseModel, Field, model_validator
+from pydantic import AfterValidator, BaseModel, Field, PrivateAttr, model_validator
 
 from railopt.studies.catalog.checks import AbscissaCheck, Check, CheckResult, HuntingCheck, _values  # noqa: F401
 from railopt.studies.catalog.setup import UNITS, ModelSetup, ParameterMap, Transform
@@ -118,14 +119,42 @@ class ModelRef(StrictModel):
         except Exception as exc:  # pydantic.ValidationError: re-raise naming the config field
             raise ValueError(field_errors(exc, f"{where}.options")) from None
 
+    _built: dict[str, Any] = PrivateAttr(default_factory=dict)
+
+    def built(self, what: str, make: Callable[[], Any]) -> Any:
+        """``make()`` once per entry and ``what``: validation builds, ``compute`` gets the same object.
+
+        Keyed on ``what``, the model name and the options, so a ``model_copy(update={"options": ...})`` builds
+        its own.  Not pickled (see :meth:`__getstate__`).
+        """
+        key = json.dumps([what, self.model, self.options], sort_keys=True, default=repr)
+        if key not in self._built:
+            self._built[key] = make()
+        return self._built[key]
+
     def setup(self, where: str = "models") -> ModelSetup:
-        """Build the model: its :class:`ModelSetup`; a ValueError names ``<where>.options`` or ``<where>.model``."""
-        entry = catalog_entry(self.model, f"{where}.model")
-        options = self.validated_options(where)  # its errors name the field already
-        try:
-            return entry.build(options)
-        except ValueError as exc:
-            raise ValueError(f"{where}.options: {exc}") from None
+        """Build the model: its :class:`ModelSetup`; a ValueError names ``<where>.options`` or ``<where>.model``.
+
+        Built once per entry (:meth:`built`): the run's ``compute`` reuses the model its validation built.
+        """
+
+        def make() -> ModelSetup:
+            entry = catalog_entry(self.model, f"{where}.model")
+            options = self.validated_options(where)  # its errors name the field already
+            try:
+                return entry.build(options)
+            except ValueError as exc:
+                raise ValueError(f"{where}.options: {exc}") from None
+
+        return self.built("setup", make)
+
+    def __getstate__(self) -> dict[Any, Any]:
+        """Pickled (e.g. into a dask task) without the built models: a task that needs one is given its setup."""
+        state = super().__getstate__()
+        private = state.get("__pydantic_private__")
+        if private and private.get("_built"):
+            state = {**state, "__pydantic_private__": {**private, "_built": {}}}
+        return state
 
 
 def require_unique(field: str, labels: Sequence[str]) -> None:

@@ -27,14 +27,8 @@ from railopt.studies.catalog import (
 from railopt.studies.config import StrictModel
 
 __all__ = [
-    "IrregularityOptions",
-    "VehicleForcedOptions",
-    "VehicleOptions",
-    "lateral_family",
-    "load",
-    "physical_limits",
-    "readable_aliases",
-    "vehicle_forced_model",
+    "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family", "load",
+    "physical_limits", "readable_aliases", "vehicle_forced_model", "vehicle_forced_setup", "vehicle_lateral_setup",
     "vehicle_setup",
 ]
 

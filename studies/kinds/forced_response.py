@@ -37,7 +37,9 @@ from railopt.studies.output.figures import plot_forced_response
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.writer import Writer
 
-__all__ = ["BandSpec", "ForcedResponseConfig", "ForcedResult", "GroupSpec", "PanelSpec", "compute", "report"]
+__all__ = [
+    "BandSpec", "FigureSpec", "ForcedResponseConfig", "ForcedResult", "GroupSpec", "PanelSpec", "compute", "report",
+]
 
 TRACKS = ("rigid", "flexible")
 
@@ -121,7 +123,8 @@ class ForcedResponseConfig(ModelsStudy):
                 opts = self.models[labels.index(label)].validated_options(f"models[{labels.index(label)}]")
                 if opts.track != track:
                     raise ValueError(f"groups[{gi}].{key}: model {label!r} is on {opts.track} track")
-                _, model, irregularity = _model(opts, f"groups[{gi}].{key}")
+                ref = self.models[labels.index(label)]
+                _, model, irregularity = ref.built("forced", lambda o=opts, w=f"groups[{gi}].{key}": _model(o, w))
                 for pi, p in enumerate(g.panels):
                     try:
                         model.forced_system(irregularity, [p.output], p.quantity)
@@ -189,8 +192,9 @@ def _group_models(cfg: ForcedResponseConfig, gi: int, g: GroupSpec) -> dict:
     models = {}
     for track in TRACKS:
         label = getattr(g, track)
-        opts = refs[label].validated_options(f"groups[{gi}].{track}")
-        models[track] = (label, opts, *_model(opts, f"groups[{gi}].{track}"))
+        where = f"groups[{gi}].{track}"
+        opts = refs[label].validated_options(where)
+        models[track] = (label, opts, *refs[label].built("forced", lambda o=opts, w=where: _model(o, w)))
     return models
 
 

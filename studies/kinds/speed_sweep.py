@@ -104,7 +104,8 @@ def _variant(ref: ModelRef, parameter: str, factor: float, where: str) -> ModelS
     except ValueError as exc:
         raise ValueError(f"{where}.parameter: {exc}") from None
     changed = {**options.parameters, parameter: factor * base}
-    return ref.model_copy(update={"options": {**ref.options, "parameters": changed}}).setup(where)
+    variant = ref.model_copy(update={"options": {**ref.options, "parameters": changed}})
+    return ref.built(f"variant {parameter} x{factor!r}", lambda: variant.setup(where))  # validation's, in compute
 
 
 def _critical_row(label: str, setup: ModelSetup, spec: CriticalSpec) -> dict:

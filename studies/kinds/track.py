@@ -38,7 +38,10 @@ from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import Curve, plot_amplification, plot_profiles, plot_time_histories
 from railopt.studies.output.writer import Writer
 
-__all__ = ["TrackResult", "TrackStudyConfig", "compute", "report"]
+__all__ = [
+    "AmplificationTable", "FiguresTable", "MovingLoadTable", "TrackResult", "TrackStudyConfig", "TrackTable",
+    "TransientTable", "compute", "report",
+]
 
 FigureName = Literal[
     "fig3_3_impulse",
@@ -463,7 +466,8 @@ def _markdown(cfg: TrackStudyConfig, s: dict, maxima: list[dict], files: list[st
     if maxima:
         lines += ["", "| figure | case | y_max (in) | x_max (in, − = behind) |", "|---|---|---|---|"]
         lines += [
-            f"| {r['figure']} | {r['case']} | {r['y_max_in']:.5f} | {r['x_max_in']:+.3f} |" for r in maxima
+            f"| {r['figure']} | {r['case']} | {r['y_max_in']:.5f} | {round(r['x_max_in'], 3) + 0.0:+.3f} |"  # no −0
+            for r in maxima
         ]
     lines += ["", "Files: " + ", ".join(files)]
     return "\n".join(lines) + "\n"

@@ -23,20 +23,9 @@ if TYPE_CHECKING:
     from railopt.design import Surface
 
 __all__ = [
-    "Boundary",
-    "Curve",
-    "FrfCurve",
-    "FrfPanel",
-    "plot_amplification",
-    "plot_before_after",
-    "plot_forced_response",
-    "plot_frf_panels",
-    "plot_profiles",
-    "plot_root_loci_before_after",
-    "plot_root_locus",
-    "plot_surfaces",
-    "plot_time_histories",
-    "plot_tradeoff",
+    "Boundary", "Curve", "FrfCurve", "FrfPanel", "StylePicker", "plot_amplification", "plot_before_after",
+    "plot_forced_response", "plot_frf_panels", "plot_profiles", "plot_root_loci_before_after", "plot_root_locus",
+    "plot_surfaces", "plot_time_histories", "plot_tradeoff", "wrap_title",
 ]
 
 _UNITS = ("inch-pound", "SI")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -190,3 +191,43 @@ def test_locomotive_stability_study_matches_the_model_layer(tmp_path):
     effect = pd.read_csv(out / "track_effect.csv").set_index("flexible")
     assert effect.loc["sd40-2_flexible", "change_m_s"] == pytest.approx(
         crit.loc["sd40-2_flexible", "critical_speed_m_s"] - crit.loc["sd40-2_rigid", "critical_speed_m_s"], abs=1e-12)
+
+
+@pytest.mark.parametrize("study", ["tmd_frf", "wheelset_stability", "locomotive_vertical_response", "tmd_hinf"])
+def test_each_model_is_built_once_per_run(study, tmp_path, monkeypatch):
+    """Validation builds each ``[[models]]`` entry and ``compute`` reuses it: in a whole run (frf, speed sweep,
+    forced response and campaign kinds) no entry builds a model twice with the same options, and every entry
+    builds (a speed sweep's parameter variants are models of their own)."""
+    import json
+
+    import railopt.studies.catalog.vehicle as catalog_vehicle
+    import railopt.studies.kinds.forced_response as forced_kind
+    from railopt.studies.catalog import MODELS, ModelRef, discover_models
+
+    builds: list[tuple[str, str]] = []
+    building: list[str] = []  # the entry whose model is being built
+    real_built = ModelRef.built
+
+    def built(self, what, make):
+        building.append(self.label)
+        try:
+            return real_built(self, what, make)
+        finally:
+            building.pop()
+
+    def note(name, options):
+        builds.append((building[0], json.dumps([name, options.model_dump(mode="json")], sort_keys=True)))
+
+    monkeypatch.setattr(ModelRef, "built", built)
+    for name, entry in list(discover_models().items()):
+        def counted(options, _build=entry.build, _name=name):
+            note(_name, options)
+            return _build(options)
+        monkeypatch.setitem(MODELS, name, replace(entry, build=counted))
+    real_forced = catalog_vehicle.vehicle_forced_model
+    monkeypatch.setattr(forced_kind, "vehicle_forced_model", lambda o: note("vehicle_forced", o) or real_forced(o))
+    path = STUDIES_DIR / f"{study}.toml"
+    assert main(["run", str(path), "--results", str(tmp_path), "--workers", "0"]) == 0
+    assert len(builds) == len(set(builds))
+    assert {label for label, _ in builds} == {m.label for m in load_study(path)[1].models}
+    assert (tmp_path / study / "summary.md").is_file()

@@ -6,10 +6,10 @@ adapter's targets are made from them by :mod:`railopt.studies.adapter`."""
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
-from pydantic import Field, PrivateAttr, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from railopt.studies.catalog import ModelSetup, ModelsStudy, PositiveInterval, require_unique
 from railopt.studies.config import FiniteModel, MethodName, StrictModel
@@ -145,35 +145,20 @@ class CampaignStudyConfig(ModelsStudy):
     report: ReportSpec = ReportSpec()
     tradeoffs: list[TradeoffSpec] = Field(default_factory=list)
     surfaces: list[SurfaceSpec] = Field(default_factory=list)
-    _setups: dict[str, ModelSetup] | None = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _resolve(self) -> CampaignStudyConfig:
         """Everything a run would reject is rejected here (``railopt validate`` = ``run``)."""
         require_unique("design.variables", [v.name for v in self.design.variables])
-        setups = {}
         for i, ref in enumerate(self.models):
             where = f"models[{i}]"
-            setup = ref.setup(where)
-            _check_setup(self, setup, where)
-            setups[ref.label] = setup
-        self._setups = setups  # built once: compute uses the models validation built
+            _check_setup(self, ref.setup(where), where)
         return self
 
     def setups(self) -> dict[str, ModelSetup]:
-        """The built model of each ``[[models]]`` entry by label: those built (and checked) on validation, built
-        again only for a config made without validation."""
-        if self._setups is None:
-            self._setups = {m.label: m.setup(f"models[{i}]") for i, m in enumerate(self.models)}
-        return dict(self._setups)
-
-    def __getstate__(self) -> dict[Any, Any]:
-        """Pickled (e.g. into a dask task) without the built models: a task that needs one is given its setup."""
-        state = super().__getstate__()
-        private = state.get("__pydantic_private__")
-        if private and private.get("_setups") is not None:
-            state = {**state, "__pydantic_private__": {**private, "_setups": None}}
-        return state
+        """The built model of each ``[[models]]`` entry by label: those built (and checked) on validation
+        (each entry keeps its model, :meth:`ModelRef.setup`)."""
+        return {m.label: m.setup(f"models[{i}]") for i, m in enumerate(self.models)}
 
 
 def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:

@@ -23,7 +23,10 @@ from railopt.studies.output.figures import (
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.writer import Writer
 
-__all__ = ["report"]
+__all__ = [
+    "before_after_section", "comparison_section", "recommended_section", "report", "surfaces_section",
+    "tradeoffs_section",
+]
 
 
 def _main_columns(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
