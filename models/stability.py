@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
+from railopt.models.crossings import speed_pencil
 from railopt.models.modal import NEUTRAL_ROOT, mode_order
 from railopt.models.mode_names import (
     HUNTING_COUPLING,
@@ -43,6 +44,15 @@ from railopt.models.mode_names import (
 )
 from railopt.models.protocols import LateralModel, SpeedFamily, StabilityModel
 from railopt.models.sensitivity import root_jacobian, root_speed_derivative
+from railopt.models.stability_map import CountedFamily as _Counted
+from railopt.models.stability_map import (
+    StabilityInterval,
+    StabilityMap,
+    abscissa,
+    resolve_model,
+    stability_map,
+    worst_speed,
+)
 from railopt.models.stability_rows import StabilityRows, damping_constraints, root_constraints
 from railopt.models.system import LinearSystem
 from railopt.models.units import rad_s_to_hz
@@ -56,6 +66,8 @@ __all__ = [
     # the analyses
     "CriticalSpeed", "RootLocus", "abscissa", "critical_speed", "critical_speed_gradient", "first_crossing",
     "least_damping", "modes", "root_locus", "spectral_abscissa",
+    # re-exported: the stability map (railopt.models.stability_map)
+    "StabilityInterval", "StabilityMap", "resolve_model", "stability_map", "worst_speed",
     # re-exported: the model types (railopt.models.protocols)
     "LateralModel", "SpeedFamily", "StabilityModel",
     # re-exported: the mode-naming vocabulary (railopt.models.mode_names)
@@ -65,48 +77,10 @@ __all__ = [
 ]
 
 
-def abscissa(s: np.ndarray) -> float:
-    """max Re s over the roots that are not neutral rigid-body roots (|s| ≤ 1e-8 max|s| counts as s = 0)."""
-    scale = float(np.max(np.abs(s))) if s.size else 0.0
-    live = s[np.abs(s) > NEUTRAL_ROOT * scale]
-    return float(np.max(live.real)) if live.size else 0.0
-
-
-def _resolve(model: StabilityModel, track: str | None) -> SpeedFamily:
-    """The model with ``at(speed=S)``: as given, or a vehicle's lateral view on ``track``."""
-    if isinstance(model, LinearSystem):
-        raise ValueError("model: a LinearSystem has one speed; give a model with at(speed=S) (a vehicle view or a "
-                         "ParametricSystem with a speed term)")
-    if track is not None or (not hasattr(model, "at") and hasattr(model, "lateral")):
-        if not hasattr(model, "lateral"):
-            raise ValueError("track: only a vehicle (with a lateral(track) view) takes track=")
-        model = model.lateral(track=track or "rigid")
-    if not callable(getattr(model, "at", None)):
-        raise ValueError(f"model: needs a method at(speed=S) returning a LinearSystem, got {type(model).__name__}")
-    return model
-
-
 def _speed_function(model: StabilityModel, track: str | None) -> Callable[[float], LinearSystem]:
     """``S -> LinearSystem`` for a model with ``at(speed=S)``, or a vehicle with ``lateral(track)``."""
-    resolved = _resolve(model, track)
+    resolved = resolve_model(model, track)
     return lambda S: resolved.at(speed=S)
-
-
-class _Counted:
-    """``S -> system`` with a count of eigen-solves."""
-
-    def __init__(self, model: StabilityModel, track: str | None) -> None:
-        resolved = _resolve(model, track)
-        self.at = lambda S: resolved.at(speed=S)
-        self.solves = 0
-        self.groups, self.main = getattr(resolved, "groups", None), getattr(resolved, "main_body", None)
-
-    def roots(self, speed: float) -> np.ndarray:
-        self.solves += 1
-        return self.at(speed).eigenvalues()
-
-    def __call__(self, speed: float) -> float:
-        return abscissa(self.roots(speed))
 
 
 def spectral_abscissa(system: LinearSystem | StabilityModel, speed: float | None = None,
@@ -163,7 +137,7 @@ def root_locus(model: StabilityModel, speeds: Sequence[float], track: str | None
         A speed that is not a positive finite number (naming ``speeds[i]``), a model without ``at(speed=S)``.
     """
     S = forward_speeds(speeds)
-    resolved = _resolve(model, track)
+    resolved = resolve_model(model, track)
     groups, main = getattr(resolved, "groups", None), getattr(resolved, "main_body", None)
     roots, names = [], []
     for v in S:
@@ -181,22 +155,30 @@ class CriticalSpeed:
     Attributes
     ----------
     speed : float
-        Critical speed, m/s; ``inf`` when stable over the whole range; the lower end of the range
-        when ``unstable_at_lower_end``.
+        Critical speed, m/s: the first speed of the range where a root has Re s > 0; ``inf`` when stable over
+        the whole range; the lower end of the range when ``unstable_at_lower_end``.
     frequency : float
         Hunting frequency |Im s|/2π of the critical root, Hz (nan when stable over the range).
     mode : str
         Name of the critical mode (:func:`mode_name`, e.g. "body hunting", "front bogie hunting"; "" if none).
     eigen_solves : int
-        Number of eigenvalue problems solved.
+        Number of eigenvalue problems of the state matrix solved (the pencil's QZ not counted).
     bracket : tuple of float
-        Final speed bracket (m/s) around the crossing; (hi, inf) when stable over the range.
+        Speed bracket (m/s) around the crossing; (hi, inf) when stable over the range.
     unstable_at_lower_end : bool
         True when a root already has Re s > 0 at the lowest speed of the range.
     tol : float
         Absolute speed tolerance, m/s.
     coordinate : str
         Coordinate with the largest amplitude in the critical root's eigenvector ("" if none).
+    method : {"pencil", "sampled"}
+        Every crossing from the bialternate pencil (:mod:`railopt.models.crossings`), or the sampled search
+        of a family without a declared creep term.
+    certified : bool
+        True only when every crossing of the range was found by the pencil and confirmed by eigen-solves
+        within ``tol`` (see :class:`~railopt.models.stability_map.StabilityMap`); never for ``"sampled"``.
+    map : StabilityMap or None
+        Every stable and unstable interval of the range (None for the sampled search).
     """
 
     speed: float
@@ -207,19 +189,28 @@ class CriticalSpeed:
     unstable_at_lower_end: bool
     tol: float
     coordinate: str = ""
+    method: str = "sampled"
+    certified: bool = False
+    map: StabilityMap | None = None
 
     @property
     def stable_over_range(self) -> bool:
         """True when no root crossed into Re s > 0 anywhere in the searched range (speed is +inf)."""
         return math.isinf(self.speed)
 
+    @property
+    def intervals(self) -> pd.DataFrame:
+        """The stable and unstable intervals of the range (:meth:`StabilityMap.to_pandas`); empty when sampled."""
+        return self.map.to_pandas() if self.map is not None else pd.DataFrame()
+
     def to_pandas(self) -> pd.DataFrame:
-        """One row: every field, the bracket as ``bracket_low``, ``bracket_high`` (m/s)."""
+        """One row: every field but the map, the bracket as ``bracket_low``, ``bracket_high`` (m/s)."""
         return pd.DataFrame([{"speed": self.speed, "frequency_hz": self.frequency, "mode": self.mode,
                               "coordinate": self.coordinate,
                               "eigen_solves": self.eigen_solves, "bracket_low": self.bracket[0],
                               "bracket_high": self.bracket[1], "unstable_at_lower_end": self.unstable_at_lower_end,
-                              "stable_over_range": self.stable_over_range, "tol": self.tol}])
+                              "stable_over_range": self.stable_over_range, "tol": self.tol, "method": self.method,
+                              "certified": self.certified}])
 
 
 def _speed_range(speed_range: object) -> tuple[float, float]:
@@ -242,14 +233,16 @@ def critical_speed(
     tol: float = 0.01,
     grid: int = 8,
 ) -> CriticalSpeed:
-    """Lowest forward speed in ``speed_range`` where a root crosses into Re s > 0.
+    """Lowest forward speed in ``speed_range`` where a root crosses into Re s > 0 — certified, without a grid.
 
-    The spectral abscissa a(S) is evaluated on ``grid`` evenly spaced speeds until it changes
-    sign; the first bracket is refined by Brent's method to ``tol`` m/s (:func:`first_crossing`).
-    A sampled local maximum of a(S) below zero is searched for a hidden unstable window first.
-    What is promised: no crossing was found at the grid's resolution after that search; an unstable
-    window that neither changes the sign of a sample nor raises a sampled local maximum (narrower than
-    the grid spacing and between samples) can be missed — raise ``grid`` when in doubt.
+    For a family with the creep term C_speed/S (a vehicle view, a ParametricSystem with ``C_speed``) every
+    speed where a root meets the imaginary axis is a real eigenvalue of the bialternate pencil
+    (:func:`~railopt.models.crossings.crossing_speeds`); the sign of the spectral abscissa between consecutive
+    candidates gives the stability map (:func:`~railopt.models.stability_map.stability_map`) and the critical
+    speed is its first unstable point, confirmed by eigen-solves within ``tol``: ``certified`` is True and the
+    answer does not depend on the range asked (for any range that contains it).  A family without the
+    declared term (a user's ``at(speed=S)``) is searched on ``grid`` speeds (:func:`first_crossing`):
+    ``method="sampled"``, never certified.
 
     Parameters
     ----------
@@ -262,7 +255,7 @@ def critical_speed(
     tol : float
         Absolute tolerance on the critical speed, m/s.
     grid : int
-        Number of bracketing speeds (>= 2).
+        Bracketing speeds of the sampled search (>= 2; unused when the pencil applies).
 
     Raises
     ------
@@ -274,6 +267,8 @@ def critical_speed(
     if isinstance(grid, bool) or not isinstance(grid, numbers.Integral) or grid < 2:
         raise ValueError(f"grid: must be an integer number of bracketing speeds ≥ 2, got {grid!r}")
     counted = _Counted(model, track)
+    if speed_pencil(counted.at(0.5 * (lo + hi))) is not None:
+        return _certified_critical(model, track, lo, hi, tol)
     found, bracket = first_crossing(counted, lo, hi, tol, int(grid))
     if found == lo and bracket == (lo, lo):
         f, mode, coordinate = _critical_root(counted, lo)
@@ -282,6 +277,27 @@ def critical_speed(
         return CriticalSpeed(math.inf, math.nan, "", counted.solves, bracket, False, tol)
     f, mode, coordinate = _critical_root(counted, bracket[1])
     return CriticalSpeed(found, f, mode, counted.solves, bracket, False, tol, coordinate)
+
+
+def _certified_critical(model: StabilityModel, track: str | None, lo: float, hi: float, tol: float) -> CriticalSpeed:
+    """The critical speed read from the certified map (σ = 0)."""
+    smap = stability_map(model, (lo, hi), track=track, tol=tol)
+    counted = _Counted(model, track)
+    first = smap.intervals[0]
+    if not first.stable:
+        f, mode, coordinate = _critical_root(counted, lo)
+        return CriticalSpeed(lo, f, mode, smap.eigen_solves + counted.solves, (lo, lo), True, tol, coordinate,
+                             smap.method, smap.certified, smap)
+    speed = smap.first_unstable
+    if math.isinf(speed):
+        return CriticalSpeed(math.inf, math.nan, "", smap.eigen_solves, (hi, math.inf), False, tol, "",
+                             smap.method, smap.certified, smap)
+    unstable = next(iv for iv in smap.intervals if not iv.stable)
+    above = min(speed + 0.5 * tol, 0.5 * (unstable.start + unstable.end))
+    f, mode, coordinate = _critical_root(counted, above)
+    bracket = (max(speed - 0.5 * tol, lo), above)
+    return CriticalSpeed(speed, f, mode, smap.eigen_solves + counted.solves, bracket, False, tol, coordinate,
+                         smap.method, smap.certified, smap)
 
 
 def first_crossing(a, lo: float, hi: float, tol: float, grid: int) -> tuple[float, tuple[float, float]]:

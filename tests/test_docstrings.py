@@ -20,23 +20,12 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-LAYERS = {"railopt.models": ROOT / "models", "railopt.design": ROOT / "design", "railopt.studies": ROOT / "studies",
-          "railopt": ROOT / "railopt"}
+from source_tree import source_modules
+
 DEFS = (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
 
 
-def _modules() -> dict[str, Path]:
-    found = {}
-    for package, folder in LAYERS.items():
-        for path in sorted(folder.rglob("*.py")):
-            rel = path.relative_to(folder).with_suffix("")
-            parts = [p for p in rel.parts if p != "__init__"]
-            found[".".join([package, *parts])] = path
-    return found
-
-
-MODULES = _modules()
+MODULES = source_modules()
 
 
 def _overload(node: ast.AST) -> bool:

@@ -11,23 +11,9 @@ import ast
 from pathlib import Path
 
 import pytest
+from source_tree import ROOT, source_modules
 
-ROOT = Path(__file__).resolve().parents[1]
-LAYERS = {"railopt.models": ROOT / "models", "railopt.design": ROOT / "design", "railopt.studies": ROOT / "studies",
-          "railopt": ROOT / "railopt"}
-
-
-def _modules() -> dict[str, Path]:
-    found = {}
-    for package, folder in LAYERS.items():
-        for path in folder.rglob("*.py"):
-            rel = path.relative_to(folder).with_suffix("")
-            parts = [p for p in rel.parts if p != "__init__"]
-            found[".".join([package, *parts])] = path
-    return found
-
-
-MODULES = _modules()
+MODULES = source_modules()
 
 
 def _type_checking(node: ast.If) -> bool:
