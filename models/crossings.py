@@ -64,6 +64,12 @@ class SpeedPencil(ArrayRecord):
         return self.size * (self.size - 1) // 2
 
 
+def declares_creep(system: LinearSystem) -> bool:
+    """True when ``system`` carries the family's creep term (a tangent with ``dC_dspeed`` at a speed)."""
+    t = system.tangent
+    return t is not None and t.dC_dspeed is not None and t.speed is not None
+
+
 def speed_pencil(system: LinearSystem) -> SpeedPencil | None:
     """The pencil of the family ``system`` belongs to, or None when it declares no creep term.
 
@@ -71,9 +77,9 @@ def speed_pencil(system: LinearSystem) -> SpeedPencil | None:
     −C_speed/S², declared by :class:`~railopt.models.parametric.ParametricSystem`), never guessed from
     samples: a system built otherwise (a user's ``at(speed=S)``) gives None and is searched by sampling.
     """
-    t = system.tangent
-    if t is None or t.dC_dspeed is None or t.speed is None:
+    if not declares_creep(system):
         return None
+    t = system.tangent
     n, S = system.n, float(t.speed)
     C_speed = -(S * S) * np.asarray(t.dC_dspeed, dtype=float)
     C0 = system.C - C_speed / S
@@ -159,4 +165,5 @@ def _pencil_values(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return u[real].real
 
 
-__all__ = ["REAL_RTOL", "RANK_RTOL", "SPEED_SLACK", "SpeedPencil", "bialternate", "crossing_speeds", "speed_pencil"]
+__all__ = ["RANK_RTOL", "REAL_RTOL", "SPEED_SLACK", "SpeedPencil", "bialternate", "crossing_speeds", "declares_creep",
+           "speed_pencil"]

@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
-from railopt.models.crossings import speed_pencil
+from railopt.models.crossings import declares_creep
 from railopt.models.modal import NEUTRAL_ROOT, mode_order
 from railopt.models.mode_names import (
     HUNTING_COUPLING,
@@ -267,7 +267,7 @@ def critical_speed(
     if isinstance(grid, bool) or not isinstance(grid, numbers.Integral) or grid < 2:
         raise ValueError(f"grid: must be an integer number of bracketing speeds ≥ 2, got {grid!r}")
     counted = _Counted(model, track)
-    if speed_pencil(counted.at(0.5 * (lo + hi))) is not None:
+    if declares_creep(counted.at(0.5 * (lo + hi))):
         return _certified_critical(model, track, lo, hi, tol)
     found, bracket = first_crossing(counted, lo, hi, tol, int(grid))
     if found == lo and bracket == (lo, lo):

@@ -40,6 +40,7 @@ from railopt.models.tmd import nishihara_asami
 from railopt.models.units import INCH, RAD_PER_HZ
 from railopt.models.vehicle import load_vehicle
 from railopt.studies.adapter import response_target
+from railopt.studies.bench_stability import critical_speed_rows
 from railopt.studies.config import load_study
 from railopt.studies.kinds.campaign import campaign_problem
 from railopt.studies.output.markdown import markdown_table
@@ -474,22 +475,8 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
 
     rows += _linfnorm_rows(max(repeat // 4, 5))
 
-    # 5. critical speed: bracketing + Brent vs a dense scan at the same resolution ------------------
-    loco = load_vehicle("sd40-2").lateral(track="rigid")
-    tol, lo, hi = 0.01, 1.0, 60.0
-    t = time.perf_counter()
-    cs = critical_speed(loco, speed_range=(lo, hi), tol=tol)
-    t_cs = time.perf_counter() - t
-    scan = np.arange(lo, hi + tol, tol)
-    t = time.perf_counter()
-    abscissa = [np.max(loco.at_speed(S).eigenvalues().real) for S in scan[: int((cs.speed - lo) / tol) + 2]]
-    t_scan = time.perf_counter() - t
-    scan_speed = scan[int(np.argmax(np.array(abscissa) > 0))]
-    rows.append({"benchmark": f"critical speed sd40-2 rigid, tol {tol} m/s: {cs.speed:.3f} m/s in "
-                              f"{cs.eigen_solves} eigen-solves", "ours_s": t_cs, "reference_s": t_scan,
-                 "reference": f"dense scan at {tol} m/s from {lo} m/s ({len(abscissa)} eigen-solves up to the "
-                              "crossing)", "ratio": t_cs / t_scan,
-                 "note": f"scan finds {scan_speed:.2f} m/s; |difference| {abs(scan_speed - cs.speed):.3f} m/s"})
+    # 5. critical speed: certified (bialternate pencil) vs the sampled search and a dense scan ------------
+    rows += critical_speed_rows()
 
     rows.append(_vehicle_summary_row())
 

@@ -135,7 +135,8 @@ def test_the_decay_rate_line_of_one_oscillator_in_closed_form(k: float) -> None:
     assert smap.certified and len(exact) >= 1
     assert smap.crossings == pytest.approx(exact, rel=1e-9)
     points = [1.0, *exact, 1000.0]
-    assert [iv.stable for iv in smap.intervals] == [holds(0.5 * (a + b)) for a, b in zip(points, points[1:], strict=False)]
+    assert [iv.stable for iv in smap.intervals] == [holds(0.5 * (a + b))
+                                                   for a, b in zip(points, points[1:], strict=False)]
 
 
 def test_speed_independent_roots_are_separated_not_a_singular_pencil() -> None:

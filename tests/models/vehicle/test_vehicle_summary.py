@@ -99,7 +99,7 @@ def test_summary_at_the_asked_speed_and_track(name: str) -> None:  # its time: `
 
 def test_reports(loco_summary) -> None:
     text = loco_summary.to_text()
-    assert "rigid     33.88 m/s (122.0 km/h)  0.671 Hz" in text
+    assert "rigid     33.88 m/s (122.0 km/h)  0.670 Hz" in text  # the frequency at the certified crossing
     assert "0.437         0.041          -0.114    body hunting" in text
     assert "- no warnings" in text
     md = loco_summary.to_markdown()
