@@ -7,13 +7,14 @@ real part of the roots, :class:`HuntingCheck` the critical speed and least dampi
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
 from railopt.models import ParametricSystem
-from railopt.models.stability import critical_speed, least_damping, spectral_abscissa
+from railopt.models.stability import critical_speed, spectral_abscissa
+from railopt.models.stability_map import least_damping_ratio, stability_map
 
 __all__ = ["AbscissaCheck", "Check", "CheckResult", "HuntingCheck"]
 
@@ -60,9 +61,17 @@ class AbscissaCheck:
 
 @dataclass(frozen=True)
 class HuntingCheck:
-    """Critical speed on each track of ``stability`` and the least damping ratio up to the maximum operating
-    speed.  Value: the lowest critical speed (m/s); ``stable``: every critical speed above ``max_speed`` and
-    every least damping ratio positive.  ``parameters`` names p; each family takes its own by name."""
+    """The stability criterion of a design on each track of ``stability``, certified.
+
+    Value: the lowest critical speed over the tracks (m/s, :func:`~railopt.models.stability.critical_speed` over
+    ``search``: every crossing from the bialternate pencil).  Flag ``stable``: on every track the critical speed
+    is above ``max_speed`` (the required speed), every root has Re s ≤ −``sigma_min`` from ``lowest_speed`` to
+    ``max_speed`` (the certified :func:`~railopt.models.stability_map.stability_map`), the least damping ratio
+    there is ≥ ``zeta_min`` and > 0 (sampled on ``damping_points`` speeds and refined by Brent: the decay rate is
+    certified, the damping ratio is sampled), and both maps are certified.  A study's ``[stability]`` sets
+    ``sigma_min``, ``zeta_min``, ``lowest_speed`` and ``max_speed`` (:meth:`with_criterion`), so the check and the
+    constraint rows state one criterion.  ``parameters`` names p; each family takes its own by name.
+    """
 
     stability: Mapping[str, ParametricSystem]
     parameters: tuple[str, ...]
@@ -71,19 +80,32 @@ class HuntingCheck:
     tol: float = 0.01
     grid: int = 16
     damping_points: int = 24
-    flag_names: ClassVar[tuple[str, ...]] = ("stable",)
+    sigma_min: float = 0.0
+    zeta_min: float = 0.0
+    lowest_speed: float | None = None
+    flag_names: ClassVar[tuple[str, ...]] = ("stable", "certified")
+
+    def with_criterion(self, *, sigma_min: float, zeta_min: float | None, lowest_speed: float | None,
+                       max_speed: float) -> HuntingCheck:
+        """The same check with a study's stability criterion (σ_min 1/s, ζ_min, speeds in m/s)."""
+        return replace(self, sigma_min=float(sigma_min), zeta_min=float(zeta_min or 0.0),
+                       lowest_speed=lowest_speed, max_speed=float(max_speed))
 
     def __call__(self, p: np.ndarray) -> CheckResult:
         data: dict[str, float] = {}
-        speeds, damping = [], []
+        speeds, holds, certified = [], [], []
+        lo = self.lowest_speed if self.lowest_speed is not None else self.search[0]
         for track, family in self.stability.items():
             model = family.with_values(_values(family, self.parameters, p))
             cs = critical_speed(model, speed_range=self.search, tol=self.tol, grid=self.grid)
-            zeta = least_damping(model, np.linspace(self.search[0], self.max_speed, self.damping_points))
-            data[f"critical_speed_{track}_m_s"] = cs.speed
-            data[f"least_damping_{track}"] = zeta
+            margin = stability_map(model, (lo, self.max_speed), sigma=self.sigma_min, tol=self.tol)
+            zeta, at = least_damping_ratio(model, (lo, self.max_speed), points=self.damping_points, tol=self.tol)
+            data.update({f"critical_speed_{track}_m_s": cs.speed, f"least_damping_{track}": zeta,
+                         f"least_damping_speed_{track}_m_s": at})
             speeds.append(cs.speed)
-            damping.append(zeta)
+            holds.append(cs.speed > self.max_speed and margin.stable and zeta >= self.zeta_min and zeta > 0)
+            certified.append(cs.certified and margin.certified)
         speed = min(speeds)
-        data["required_speed_m_s"] = self.max_speed
-        return CheckResult(speed, {"stable": bool(speed > self.max_speed and min(damping) > 0)}, data)
+        data.update(required_speed_m_s=self.max_speed, sigma_min=self.sigma_min, zeta_min=self.zeta_min)
+        return CheckResult(speed, {"stable": bool(all(holds) and all(certified)), "certified": bool(all(certified))},
+                           data)

@@ -6,6 +6,7 @@ adapter's targets are made from them by :mod:`railopt.studies.adapter`."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import ClassVar, Literal
 
 import numpy as np
@@ -157,8 +158,21 @@ class CampaignStudyConfig(ModelsStudy):
 
     def setups(self) -> dict[str, ModelSetup]:
         """The built model of each ``[[models]]`` entry by label: those built (and checked) on validation
-        (each entry keeps its model, :meth:`ModelRef.setup`)."""
-        return {m.label: m.setup(f"models[{i}]") for i, m in enumerate(self.models)}
+        (each entry keeps its model, :meth:`ModelRef.setup`), the ``hunting`` check stating the ``[stability]``
+        criterion of the study (σ_min, ζ_min, the lowest and the required speed), as the constraint rows do."""
+        key = "criterion " + ("none" if self.stability is None else self.stability.model_dump_json())
+        return {m.label: m.built(key, lambda m=m, i=i: self._with_criterion(m.setup(f"models[{i}]")))
+                for i, m in enumerate(self.models)}
+
+    def _with_criterion(self, setup: ModelSetup) -> ModelSetup:
+        check = setup.checks.get("hunting")
+        if self.stability is None or check is None or not hasattr(check, "with_criterion"):
+            return setup
+        spec = self.stability
+        lowest = spec.lowest_speed_m_s or spec.required(setup) / spec.speeds
+        stated = check.with_criterion(sigma_min=spec.sigma_min, zeta_min=spec.zeta_min, lowest_speed=lowest,
+                                      max_speed=spec.required(setup))
+        return replace(setup, checks={**setup.checks, "hunting": stated})
 
 
 def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:
