@@ -52,6 +52,11 @@ class MinimaxProblem:
         Right-hand side of g(x) ≤ ε.
     fd_step : float
         Relative finite-difference step (of each variable's range).
+    refine : callable, optional
+        Semi-infinite constraints by exchange (constraint generation): ``refine(x) -> MinimaxProblem | None``
+        certifies a solved design against the continuum the rows sample (e.g. every speed of a range) and returns
+        the problem with rows added where it is violated, or None when ``x`` is certified.  :func:`solve` then
+        resumes from ``x`` on the refined problem, up to ``MAX_EXCHANGES`` rounds.
     """
 
     def __init__(
@@ -63,8 +68,12 @@ class MinimaxProblem:
         constraint_jacobian: VectorFunction | bool | None = None,
         epsilon: float | Sequence[float] = 0.0,
         fd_step: float = 1e-6,
+        refine: Callable[[np.ndarray], MinimaxProblem | None] | None = None,
     ) -> None:
         self.space = Space(variables)
+        if refine is not None and not callable(refine):
+            raise ValueError("refine: must be callable, x -> MinimaxProblem or None")
+        self.refine = refine
         if not callable(functions):
             raise ValueError("functions: must be callable, x -> (m,) array")
         if jacobian is not None and jacobian is not True and not callable(jacobian):
@@ -88,7 +97,8 @@ class MinimaxProblem:
     def with_constraints(self, constraints: VectorFunction | None,
                          constraint_jacobian: VectorFunction | bool | None = None,
                          epsilon: float | Sequence[float] = 0.0) -> MinimaxProblem:
-        """The same objective subject to other constraints g(x) ≤ ε (conventions as in the constructor)."""
+        """The same objective subject to other constraints g(x) ≤ ε (conventions as in the constructor); the
+        exchange (``refine``) belongs to the constraints it refined and is not carried over."""
         return MinimaxProblem(self.variables, self._functions, self._jacobian, constraints, constraint_jacobian,
                               epsilon, self.fd_step)
 

@@ -17,6 +17,8 @@ STATUSES: dict[str, str] = {
     "forced_stop": "the run was stopped by a callback; best point kept",
     "failure": "the solver failed (e.g. SLSQP's iteration limit or a singular QP); best point kept",
     "error": "the problem functions raised an exception; best point kept",
+    "uncertified": "a semi-infinite constraint stayed violated after the exchange limit (MAX_EXCHANGES rounds of "
+                   "rows added where the certificate found it violated); best point kept",
     "worker_lost": "the start killed every dask worker that ran it (a crash in native code, out of memory); "
                    "x = x0, U = inf; a resume skips it unless retry_failed",
 }

@@ -6,6 +6,7 @@ import math
 import numbers
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -16,6 +17,7 @@ from railopt.design.problem import Evaluation, MinimaxProblem
 from railopt.design.result import SUCCESS_STATUSES, SolveResult
 
 MAX_EVAL = 2**31 - 1  # NLopt's set_maxeval takes a C int
+MAX_EXCHANGES = 6  # rounds of rows added by a semi-infinite constraint's certificate before "uncertified"
 
 
 def method_options(method: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -68,8 +70,33 @@ def solve(problem: MinimaxProblem, x0: Sequence[float], method: str = "slsqp", *
     Returns
     -------
     SolveResult
-        With ``value`` = U(x) re-evaluated at the returned x; never raises for solver failures.
+        With ``value`` = U(x) re-evaluated at the returned x; never raises for solver failures.  A problem with
+        ``refine`` (semi-infinite constraints) is solved by exchange: each successful solve is certified by
+        ``refine(x)``; where it returns a refined problem the solve resumes from x on it, at most
+        ``MAX_EXCHANGES`` times, then the status is ``"uncertified"`` (never a success).  The message counts the
+        rounds; evaluations and wall time add up over them.
     """
+    result = _solve_once(problem, x0, method, options)
+    rounds, evaluations, wall = 0, result.evaluations, result.wall_time
+    while problem.refine is not None and result.success:
+        refined = problem.refine(result.x)
+        if refined is None:
+            if rounds:
+                result = replace(result, message=f"{result.message}; certified after {rounds} exchange round(s)")
+            break
+        if rounds == MAX_EXCHANGES:
+            result = replace(result, status="uncertified",
+                             message=f"{result.message}; still violated after {rounds} exchange rounds")
+            break
+        rounds += 1
+        problem = refined
+        result = _solve_once(problem, result.x, method, options)
+        evaluations, wall = evaluations + result.evaluations, wall + result.wall_time
+    return replace(result, evaluations=evaluations, wall_time=wall, x0=np.asarray(x0, dtype=float)) if rounds \
+        else result
+
+
+def _solve_once(problem: MinimaxProblem, x0: Sequence[float], method: str, options: dict[str, Any]) -> SolveResult:
     opts = method_options(method, options)
     x0 = problem.space.check_point(x0)
     start = time.perf_counter()
@@ -123,4 +150,4 @@ def _result(problem: MinimaxProblem, x0: np.ndarray, x: np.ndarray, ev: Evaluati
     )
 
 
-__all__ = ["MAX_EVAL", "method_options", "solve"]
+__all__ = ["MAX_EVAL", "MAX_EXCHANGES", "method_options", "solve"]

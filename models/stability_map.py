@@ -1,6 +1,6 @@
 """The stability map of a speed family: every stable and unstable speed interval of a range, certified.
 
-For a margin σ ≥ 0 (1/s) a speed is *stable* when every root that is not a neutral rigid-body root has
+For a margin σ (1/s; usually ≥ 0) a speed is *stable* when every root that is not a neutral rigid-body root has
 Re s ≤ −σ (σ = 0: no hunting; σ > 0: a decay-rate margin).  The margin function m(S) = a(S) + σ, with a(S)
 the spectral abscissa, changes sign only at a speed where a root meets the line Re s = −σ; for a family with the
 creep term C_speed/S every such speed is a real eigenvalue of a pencil (:mod:`railopt.models.crossings`), found
@@ -182,7 +182,7 @@ def stability_map(model: StabilityModel, speed_range: tuple[float, float] = (1.0
     track : {"rigid", "flexible"}, optional
         For a vehicle definition: the lateral view on this track.
     sigma : float
-        Decay-rate margin σ ≥ 0, 1/s.
+        Decay-rate margin σ, 1/s: the line Re s = −σ (σ < 0, a line right of the axis, is a tolerance).
     tol : float
         Speed tolerance of each crossing, m/s.
 
@@ -195,8 +195,6 @@ def stability_map(model: StabilityModel, speed_range: tuple[float, float] = (1.0
 
     lo, hi = _speed_range(speed_range)
     sigma = number("sigma", sigma)
-    if sigma < 0:
-        raise ValueError(f"sigma: must be ≥ 0 (a decay rate, 1/s), got {sigma}")
     tol = number("tol", tol, positive=True)
     family = CountedFamily(model, track)
     pencil = speed_pencil(family.at(0.5 * (lo + hi)))

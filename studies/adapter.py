@@ -20,7 +20,7 @@ the RMS to the quadrature tolerance).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -30,9 +30,11 @@ from railopt.models import LinearSystem
 from railopt.models.random_response import random_response
 from railopt.models.response_maxima import all_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
+from railopt.models.stability_map import least_damping_ratio, stability_map, worst_speed
 from railopt.models.stability_rows import StabilityRows
 from railopt.models.units import RAD_PER_HZ
 from railopt.studies.catalog import ModelSetup
+from railopt.studies.catalog.checks import CRITERION_TOL
 
 if TYPE_CHECKING:
     from railopt.studies.specs import ObjectiveSpec, OutputSpec, StabilitySpec
@@ -40,6 +42,7 @@ if TYPE_CHECKING:
 __all__ = [
     "RMSTarget",
     "ResponseTarget",
+    "StabilityExchange",
     "StabilityTarget",
     "minimax_problem",
     "response_target",
@@ -313,6 +316,8 @@ def minimax_problem(
     if stability is not None:
         epsilon = np.concatenate([epsilon, np.zeros(stability.rows(setup))])
     targets = list(constraints)
+    refine = None if stability is None else StabilityExchange(setup, tuple(variables), objective, tuple(constraints),
+                                                               tuple(limits), stability)
     return MinimaxProblem(
         list(variables),
         lambda x: evaluator.objective(x, objective),
@@ -320,4 +325,60 @@ def minimax_problem(
         constraints=lambda x: evaluator.constraints(x, targets, stability),
         constraint_jacobian=lambda x: evaluator.constraints_jacobian(x, targets, stability),
         epsilon=epsilon,
+        refine=refine,
     )
+
+
+@dataclass(frozen=True)
+class StabilityExchange:
+    """The certificate of the stability rows as a semi-infinite constraint (``MinimaxProblem.refine``).
+
+    The rows hold Re s_j + σ_min ≤ 0 (and ζ_j ≥ ζ_min) at grid speeds; the criterion is every speed from the first
+    to the last row.  For a solved design x, on each track: the certified stability map for the line Re s = −σ_min
+    (:func:`~railopt.models.stability_map.stability_map`) gives every violating interval; the speed where the
+    spectral abscissa peaks in it (:func:`~railopt.models.stability_map.worst_speed`) becomes a new row when a
+    kept mode (the rows' modes: track modes and ``exclude`` left out) violates there by more than
+    :data:`~railopt.studies.catalog.checks.CRITERION_TOL` (the rows' feasibility tolerance, as the check allows).  With ζ_min the least
+    damping ratio (sampled and refined) adds its speed likewise.  Returns the problem with those speeds added, or
+    None when x meets the criterion at every speed (:func:`railopt.design.solve` resumes from x until then).
+    """
+
+    setup: ModelSetup
+    variables: tuple[DesignVariable, ...]
+    objective: ResponseTarget | RMSTarget
+    constraints: tuple[ResponseTarget, ...]
+    limits: tuple[float, ...]
+    stability: StabilityTarget
+    tol: float = 0.01
+
+    def new_speeds(self, x: np.ndarray) -> list[float]:
+        """The speeds (m/s) where the design ``x`` violates the criterion between the rows, ascending."""
+        names = [v.name for v in self.variables]
+        p, _ = self.setup.parameters(names, np.asarray(x, dtype=float))
+        lo, hi = min(self.stability.speeds), max(self.stability.speeds)
+        found: list[float] = []
+        for track in self.stability.tracks:
+            model = self.setup.stability_model(p, track)
+            smap = (stability_map(model, (lo, hi), sigma=self.stability.sigma_min - CRITERION_TOL, tol=self.tol)
+                    if hi > lo else None)
+            candidates = [] if smap is None else [worst_speed(model, (iv.start, iv.end), tol=self.tol)[0]
+                                                   for iv in smap.intervals if not iv.stable]
+            if self.stability.zeta_min is not None and hi > lo:
+                zeta, at = least_damping_ratio(model, (lo, hi), tol=self.tol)
+                if zeta < self.stability.zeta_min - CRITERION_TOL:
+                    candidates.append(at)
+            for S in candidates:
+                rows = StabilityRows(model, None, [S], self.stability.exclude)
+                worst = float(np.max(rows.roots(self.stability.sigma_min)))
+                if self.stability.zeta_min is not None:
+                    worst = max(worst, float(np.max(rows.damping(self.stability.zeta_min))))
+                if worst > CRITERION_TOL and all(abs(S - q) > 0.5 * self.tol for q in (*self.stability.speeds, *found)):
+                    found.append(float(S))
+        return sorted(found)
+
+    def __call__(self, x: np.ndarray) -> MinimaxProblem | None:
+        new = self.new_speeds(x)
+        if not new:
+            return None
+        stability = replace(self.stability, speeds=tuple(sorted((*self.stability.speeds, *new))))
+        return minimax_problem(self.setup, self.variables, self.objective, self.constraints, self.limits, stability)

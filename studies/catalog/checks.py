@@ -16,7 +16,9 @@ from railopt.models import ParametricSystem
 from railopt.models.stability import critical_speed, spectral_abscissa
 from railopt.models.stability_map import least_damping_ratio, stability_map
 
-__all__ = ["AbscissaCheck", "Check", "CheckResult", "HuntingCheck"]
+__all__ = ["CRITERION_TOL", "AbscissaCheck", "Check", "CheckResult", "HuntingCheck"]
+
+CRITERION_TOL = 1e-6  # 1/s and damping ratio: the constraint rows' feasibility tolerance, allowed by the check too
 
 
 @dataclass(frozen=True)
@@ -67,7 +69,7 @@ class HuntingCheck:
     ``search``: every crossing from the bialternate pencil).  Flag ``stable``: on every track the critical speed
     is above ``max_speed`` (the required speed), every root has Re s ≤ −``sigma_min`` from ``lowest_speed`` to
     ``max_speed`` (the certified :func:`~railopt.models.stability_map.stability_map`), the least damping ratio
-    there is ≥ ``zeta_min`` and > 0 (sampled on ``damping_points`` speeds and refined by Brent: the decay rate is
+    there is ≥ ``zeta_min`` and > 0 (both to :data:`CRITERION_TOL`, the rows' feasibility tolerance; sampled on ``damping_points`` speeds and refined by Brent: the decay rate is
     certified, the damping ratio is sampled), and both maps are certified.  A study's ``[stability]`` sets
     ``sigma_min``, ``zeta_min``, ``lowest_speed`` and ``max_speed`` (:meth:`with_criterion`), so the check and the
     constraint rows state one criterion.  ``parameters`` names p; each family takes its own by name.
@@ -98,12 +100,13 @@ class HuntingCheck:
         for track, family in self.stability.items():
             model = family.with_values(_values(family, self.parameters, p))
             cs = critical_speed(model, speed_range=self.search, tol=self.tol, grid=self.grid)
-            margin = stability_map(model, (lo, self.max_speed), sigma=self.sigma_min, tol=self.tol)
+            margin = stability_map(model, (lo, self.max_speed), sigma=self.sigma_min - CRITERION_TOL, tol=self.tol)
             zeta, at = least_damping_ratio(model, (lo, self.max_speed), points=self.damping_points, tol=self.tol)
             data.update({f"critical_speed_{track}_m_s": cs.speed, f"least_damping_{track}": zeta,
                          f"least_damping_speed_{track}_m_s": at})
             speeds.append(cs.speed)
-            holds.append(cs.speed > self.max_speed and margin.stable and zeta >= self.zeta_min and zeta > 0)
+            holds.append(cs.speed > self.max_speed and margin.stable and zeta >= self.zeta_min - CRITERION_TOL
+                         and zeta > 0)
             certified.append(cs.certified and margin.certified)
         speed = min(speeds)
         data.update(required_speed_m_s=self.max_speed, sigma_min=self.sigma_min, zeta_min=self.zeta_min)

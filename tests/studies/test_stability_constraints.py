@@ -57,29 +57,47 @@ def test_the_constrained_optimum_is_the_best_feasible_point_of_a_dense_grid(tmp_
     x_opt = best[list(problem.space.names)].to_numpy(float)
     ev = problem.evaluate(x_opt)
     assert problem.constraint_violation(x_opt, ev) <= 1e-9  # every constraint met to its tolerance
-    # the dense grid (100 × 100, log-spaced over the bounds): feasible where every root (none is a track mode on
-    # rigid track; neutral roots aside) has Re s + σ ≤ 0 at the grid's speeds — eigenvalues alone — U there
+    # grids of designs: 40 × 40 log-spaced over the bounds (nothing beats the optimum anywhere) and 30 × 30 within
+    # ±8 % of it (the best feasible grid point is within 1e-3 of it); feasible where every root (none is a track
+    # mode on rigid track; neutral roots aside) has Re s + σ ≤ 0 — eigenvalues alone — U there
     family = setup.stability["rigid"]
     speeds = stability_target(cfg.stability, setup).speeds
     names = [v.name for v in cfg.design.variables]
-    grid = [np.geomspace(v.lower, v.upper, 100) for v in cfg.design.variables]
+    grid = [np.concatenate([np.geomspace(v.lower, v.upper, 40),
+                            np.clip(np.geomspace(0.92 * x, 1.08 * x, 30), v.lower, v.upper)])
+            for v, x in zip(cfg.design.variables, x_opt, strict=True)]
     params = list(setup.family.parameters)
     rows = [params.index(n) for n in family.parameters]
     g_opt, _ = root_constraints(family, setup.parameters(names, x_opt)[0][rows], speeds, cfg.stability.sigma_min)
     assert np.max(g_opt) <= 1e-9
     objective = campaign_problem(cfg, setup, "exact", "unconstrained")  # U alone, no constraint rows
-    feasible_U = []
+    # the criterion is every speed from the first row to the last (the rows are exchanged until it holds): a grid
+    # design is feasible when Re s + σ ≤ 0 (to the rows' 1e-6 tolerance) on a 0.05 m/s scan of that range
+    fine = np.arange(speeds[0], speeds[-1] + 1e-9, 0.05)
+    fine = fine[np.argsort(-np.min(np.abs(fine[:, None] - np.asarray(speeds)[None, :]), axis=1))]  # far from rows first
+
+    def feasible(p: np.ndarray, at: np.ndarray) -> bool:  # stops at the first violating speed
+        return not any(abscissa(family.at(p[rows], speed=S).eigenvalues()) + cfg.stability.sigma_min > 1e-6
+                       for S in at)
+
+    worst_opt = max(abscissa(family.at(setup.parameters(names, x_opt)[0][rows], speed=S).eigenvalues())
+                    for S in fine) + cfg.stability.sigma_min
+    assert worst_opt <= 1e-6  # the optimum meets the criterion between the rows too
+    at_rows = []  # feasible at the rows' speeds (necessary), with U
     for a in grid[0]:
         for b in grid[1]:
             p, _ = setup.parameters(names, np.array([a, b]))
-            worst = max(abscissa(family.at(p[rows], speed=S).eigenvalues()) for S in speeds)
-            if worst + cfg.stability.sigma_min <= 0.0:
-                feasible_U.append(objective.value([a, b]))
-    assert len(feasible_U) > 100
-    grid_best = min(feasible_U)
+            if feasible(p, np.asarray(speeds)):
+                at_rows.append((objective.value([a, b]), p))
+    assert len(at_rows) > 100
+    grid_best = None
+    for value, p in sorted(at_rows, key=lambda vp: vp[0]):  # ascending U: the first feasible over the range
+        if feasible(p, fine):
+            grid_best = value
+            break
+    assert grid_best is not None
     assert ev.value <= grid_best * (1 + 1e-9)  # nothing on the grid beats the optimum
     assert abs(ev.value - grid_best) <= 1e-3 * grid_best
-
 
 
 @pytest.mark.parametrize("method", ["slsqp", "cobyla", "slp"])
@@ -102,7 +120,13 @@ def test_every_constrained_method_takes_the_stability_rows(tmp_path, method: str
     p = setup.parameters(list(problem.space.names), x)[0][[params.index(n) for n in family.parameters]]
     g_roots, _ = root_constraints(family, p, stability_target(cfg.stability, setup).speeds, cfg.stability.sigma_min)
     assert np.allclose(ev.g[-len(g_roots):], g_roots, rtol=0, atol=1e-12)  # the stability rows come last
-    assert abs(float(np.max(g_roots))) <= 1e-6 * float(np.max(np.abs(g_roots)))  # ... and one of them is active
+    assert float(np.max(g_roots)) <= 1e-6
+    # on the stability boundary of the continuum (the rows are exchanged until every speed holds): the largest
+    # Re s + σ over a 0.05 m/s scan of the rows' range is zero, to the rows' tolerance and the scan's resolution
+    target = stability_target(cfg.stability, setup)
+    scan = np.arange(target.speeds[0], target.speeds[-1] + 1e-9, 0.05)
+    worst = max(abscissa(family.at(p, speed=S).eigenvalues()) for S in scan) + cfg.stability.sigma_min
+    assert -1e-4 <= worst <= 1e-6
     lower, upper = problem.space.lower, problem.space.upper
     assert lower[0] * (1 + 1e-3) < x[0] < upper[0] * (1 - 1e-3)  # C13 held by the roots, not by its bounds
     assert ev.value == pytest.approx(U_ref, rel=1e-6)
