@@ -336,11 +336,12 @@ class StabilityExchange:
     The rows hold Re s_j + σ_min ≤ 0 (and ζ_j ≥ ζ_min) at grid speeds; the criterion is every speed from the first
     to the last row.  For a solved design x, on each track: the certified stability map for the line Re s = −σ_min
     (:func:`~railopt.models.stability_map.stability_map`) gives every violating interval; the speed where the
-    spectral abscissa peaks in it (:func:`~railopt.models.stability_map.worst_speed`) becomes a new row when a
-    kept mode (the rows' modes: track modes and ``exclude`` left out) violates there by more than
-    :data:`~railopt.studies.catalog.checks.CRITERION_TOL` (the rows' feasibility tolerance, as the check allows).  With ζ_min the least
-    damping ratio (sampled and refined) adds its speed likewise.  Returns the problem with those speeds added, or
-    None when x meets the criterion at every speed (:func:`railopt.design.solve` resumes from x until then).
+    spectral abscissa peaks in it (:func:`~railopt.models.stability_map.worst_speed`) becomes a new row when a kept
+    mode (the rows' modes: track modes and ``exclude`` left out) violates there by more than
+    :data:`~railopt.studies.catalog.checks.CRITERION_TOL` (the rows' feasibility tolerance, as the check allows).
+    With ζ_min the least damping ratio (sampled and refined) adds its speed likewise.  Returns the problem with
+    those speeds added, or None when x meets the criterion at every speed (:func:`railopt.design.solve` resumes from
+    x until then).
     """
 
     setup: ModelSetup

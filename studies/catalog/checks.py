@@ -66,13 +66,14 @@ class HuntingCheck:
     """The stability criterion of a design on each track of ``stability``, certified.
 
     Value: the lowest critical speed over the tracks (m/s, :func:`~railopt.models.stability.critical_speed` over
-    ``search``: every crossing from the bialternate pencil).  Flag ``stable``: on every track the critical speed
-    is above ``max_speed`` (the required speed), every root has Re s ≤ −``sigma_min`` from ``lowest_speed`` to
-    ``max_speed`` (the certified :func:`~railopt.models.stability_map.stability_map`), the least damping ratio
-    there is ≥ ``zeta_min`` and > 0 (both to :data:`CRITERION_TOL`, the rows' feasibility tolerance; sampled on ``damping_points`` speeds and refined by Brent: the decay rate is
-    certified, the damping ratio is sampled), and both maps are certified.  A study's ``[stability]`` sets
-    ``sigma_min``, ``zeta_min``, ``lowest_speed`` and ``max_speed`` (:meth:`with_criterion`), so the check and the
-    constraint rows state one criterion.  ``parameters`` names p; each family takes its own by name.
+    ``search``: every crossing from the bialternate pencil).  Flag ``stable``: on every track the critical speed is
+    above ``max_speed`` (the required speed), every root has Re s ≤ −``sigma_min`` from ``lowest_speed`` to
+    ``max_speed`` (the certified :func:`~railopt.models.stability_map.stability_map`), the least damping ratio there
+    is ≥ ``zeta_min`` and > 0 (both to :data:`CRITERION_TOL`, the rows' feasibility tolerance; sampled on
+    ``damping_points`` speeds and refined by Brent: the decay rate is certified, the damping ratio is sampled), and
+    both maps are certified.  A study's ``[stability]`` sets ``sigma_min``, ``zeta_min``, ``lowest_speed`` and
+    ``max_speed`` (:meth:`with_criterion`), so the check and the constraint rows state one criterion.
+    ``parameters`` names p; each family takes its own by name.
     """
 
     stability: Mapping[str, ParametricSystem]
