@@ -16,8 +16,9 @@ from railopt.models import ParametricSystem
 from railopt.models.stability import critical_speed, spectral_abscissa
 from railopt.models.stability_map import least_damping_ratio, stability_map
 
-__all__ = ["CRITERION_TOL", "AbscissaCheck", "Check", "CheckResult", "HuntingCheck"]
+__all__ = ["CRITERION_TOL", "MEMO_SIZE", "AbscissaCheck", "Check", "CheckResult", "HuntingCheck"]
 
+MEMO_SIZE = 256  # designs a hunting check remembers
 CRITERION_TOL = 1e-6  # 1/s and damping ratio: the constraint rows' feasibility tolerance, allowed by the check too
 
 
@@ -87,6 +88,14 @@ class HuntingCheck:
     zeta_min: float = 0.0
     lowest_speed: float | None = None
     flag_names: ClassVar[tuple[str, ...]] = ("stable", "certified")
+    _memo: dict = field(default_factory=dict, init=False, compare=False, repr=False)
+
+    def __getstate__(self) -> dict:
+        """Pickled (into a dask task) without the results it remembers."""
+        return {k: v for k, v in self.__dict__.items() if k != "_memo"}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state, _memo={})
 
     def with_criterion(self, *, sigma_min: float, zeta_min: float | None, lowest_speed: float | None,
                        max_speed: float) -> HuntingCheck:
@@ -94,7 +103,21 @@ class HuntingCheck:
         return replace(self, sigma_min=float(sigma_min), zeta_min=float(zeta_min or 0.0),
                        lowest_speed=lowest_speed, max_speed=float(max_speed))
 
+    def critical_speed(self, p: np.ndarray) -> float:
+        """The check's value alone (the lowest certified critical speed over the tracks, m/s): what a surface's
+        boundary needs, without the margin and damping searches."""
+        return min(critical_speed(family.with_values(_values(family, self.parameters, p)), speed_range=self.search,
+                                  tol=self.tol, grid=self.grid).speed for family in self.stability.values())
+
     def __call__(self, p: np.ndarray) -> CheckResult:
+        key = np.asarray(p, dtype=float).tobytes()  # a trade-off asks the same design for its front, pick, quantity
+        if key not in self._memo:
+            if len(self._memo) >= MEMO_SIZE:
+                self._memo.clear()
+            self._memo[key] = self._check(p)
+        return self._memo[key]
+
+    def _check(self, p: np.ndarray) -> CheckResult:
         data: dict[str, float] = {}
         speeds, holds, certified = [], [], []
         lo = self.lowest_speed if self.lowest_speed is not None else self.search[0]

@@ -24,6 +24,7 @@ from railopt.studies.catalog.vehicle import load
 from railopt.studies.config import FiniteModel, Interval
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_root_locus
+from railopt.studies.output.map_figure import plot_stability_map
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.writer import Writer
 
@@ -108,13 +109,19 @@ def _variant(ref: ModelRef, parameter: str, factor: float, where: str) -> ModelS
     return ref.built(f"variant {parameter} x{factor!r}", lambda: variant.setup(where))  # validation's, in compute
 
 
-def _critical_row(label: str, setup: ModelSetup, spec: CriticalSpec) -> dict:
+def _critical(label: str, setup: ModelSetup, spec: CriticalSpec) -> tuple[dict, pd.DataFrame]:
+    """The critical-speed row of a model and its stability map (every stable and unstable interval)."""
     cs = critical_speed(setup.stability_model(setup.defaults), speed_range=spec.range_m_s, tol=spec.tol_m_s,
                         grid=spec.points)
-    return {"model": label, "critical_speed_m_s": cs.speed, "critical_speed_mph": cs.speed / MPH,
-            "hunting_frequency_hz": cs.frequency, "mode": cs.mode, "eigen_solves": cs.eigen_solves,
-            "unstable_at_lower_end": cs.unstable_at_lower_end, "stable_over_range": math.isinf(cs.speed),
-            "tol_m_s": cs.tol}
+    row = {"model": label, "critical_speed_m_s": cs.speed, "critical_speed_mph": cs.speed / MPH,
+           "hunting_frequency_hz": cs.frequency, "mode": cs.mode, "eigen_solves": cs.eigen_solves,
+           "unstable_at_lower_end": cs.unstable_at_lower_end, "stable_over_range": math.isinf(cs.speed),
+           "tol_m_s": cs.tol, "method": cs.method, "certified": cs.certified}
+    return row, cs.intervals.assign(model=label)
+
+
+def _critical_row(label: str, setup: ModelSetup, spec: CriticalSpec) -> dict:
+    return _critical(label, setup, spec)[0]
 
 
 @dataclass(frozen=True)
@@ -127,6 +134,7 @@ class SpeedSweepResult:
     table: pd.DataFrame
     sensitivity: pd.DataFrame
     track_effect: pd.DataFrame
+    maps: pd.DataFrame
 
 
 def _locus_and_damping(label: str, setup: ModelSetup, speeds: np.ndarray) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -156,17 +164,20 @@ def compute(config: SpeedSweepConfig, context: StudyContext) -> SpeedSweepResult
     compared in ``track_effect``.
     """
     cfg = config
-    loci, critical, damping, sens_rows = [], [], [], []
+    loci, critical, damping, sens_rows, maps = [], [], [], [], []
     for i, ref in enumerate(cfg.models):
         setup = ref.setup(f"models[{i}]")
         locus, damp = _locus_and_damping(ref.label, setup, cfg.speeds.speeds())
         loci.append(locus)
         damping.append(damp)
-        critical.append(_critical_row(ref.label, setup, cfg.critical))
+        row, intervals = _critical(ref.label, setup, cfg.critical)
+        critical.append(row)
+        maps.append(intervals)
         sens_rows += _sensitivity_rows(cfg, ref)
     critical_table = pd.DataFrame(critical)
     return SpeedSweepResult(cfg, pd.concat(loci, ignore_index=True), pd.concat(damping, ignore_index=True),
-                            critical_table, pd.DataFrame(sens_rows), _track_effect(cfg, critical_table))
+                            critical_table, pd.DataFrame(sens_rows), _track_effect(cfg, critical_table),
+                            pd.concat(maps, ignore_index=True))
 
 
 def report(result: SpeedSweepResult, writer: Writer) -> str:
@@ -178,6 +189,11 @@ def report(result: SpeedSweepResult, writer: Writer) -> str:
     if len(sens_table):
         writer.table(sens_table, "sensitivity")
     writer.figure(plot_root_locus(result.locus, critical_table), "root_locus", dpi=cfg.dpi)
+    if len(result.maps):
+        writer.table(result.maps[["model", *[c for c in result.maps.columns if c != "model"]]], "stability_map")
+        writer.figure(plot_stability_map(result.damping, result.maps, f"{cfg.study.name}: stability map over "
+                                         f"{cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s"),
+                      "stability_map", dpi=cfg.dpi)
     lines = [f"# {cfg.study.name}", "", cfg.study.description, "",
              f"Root locus over {cfg.speeds.range_m_s[0]:g}–{cfg.speeds.range_m_s[1]:g} m/s; critical speed searched "
              f"in {cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s to ±{cfg.critical.tol_m_s:g} m/s.",
@@ -191,6 +207,15 @@ def report(result: SpeedSweepResult, writer: Writer) -> str:
                                        sort=False).reset_index()
         lines += ["Critical speed (m/s) with one parameter scaled by `factor` (all columns in `sensitivity.csv`):",
                   "", markdown_table(pivot, digits=5), ""]
+    if len(result.maps):
+        verdict = ("certified for every model" if bool(critical_table["certified"].all())
+                   else "NOT certified for every model (see the method column)")
+        lines += [f"Stability map (`stability_map.csv`): every stable and unstable interval of "
+                  f"{cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s, each crossing found by the "
+                  "bialternate pencil (no speed grid) and confirmed by eigen-solves within "
+                  f"{cfg.critical.tol_m_s:g} m/s — {verdict}:", "",
+                  markdown_table(result.maps[["model", "start_m_s", "end_m_s", "state", "mode_at_start",
+                                              "mode_at_end"]], digits=5), "", "![stability map](stability_map.png)", ""]
     lines += ["![root locus](root_locus.png)", ""]
     return "\n".join(lines)
 

@@ -388,15 +388,21 @@ def plot_root_loci_before_after(loci: dict[str, pd.DataFrame], title: str, max_h
 
 
 def plot_tradeoff(table: pd.DataFrame, quantity: str, title: str, required: float | None = None) -> Figure:
-    """U against a traded quantity: every design (campaign starts, sweep optima), the non-dominated front and,
-    with ``required``, the requirement as a vertical line."""
+    """U against a traded quantity: every design (campaign starts, sweep optima), the non-dominated front of the
+    feasible ones and, with ``required``, the requirement as a vertical line; designs that miss another constraint
+    (``feasible`` False: unconstrained starts, designs that hunt) are drawn apart, never on the front."""
     fig = Figure(figsize=(6.6, 4.4))
     ax = fig.subplots()
-    starts = table[table["source"] == "start"]
-    sweep = table[table["source"] == "sweep"]
+    ok = table["feasible"] if "feasible" in table.columns else pd.Series(True, index=table.index)
+    starts = table[table["source"].str.startswith("start") & ok]
+    sweep = table[(table["source"] == "sweep") & ok]
+    missed = table[~ok]
     front = table[table["nondominated"]].sort_values(quantity)
     ax.scatter(starts[quantity], starts["U"], s=10, color="0.6", marker="o", label="campaign starts")
     ax.scatter(sweep[quantity], sweep["U"], s=22, color="C0", marker="s", label="constrained optima per target")
+    if len(missed):
+        ax.scatter(missed[quantity], missed["U"], s=16, color="C1", marker="x",
+                   label="missing another constraint (not on the front)")
     ax.plot(front[quantity], front["U"], color="C3", ls="-", marker=".", lw=1.2, label="non-dominated")
     if required is not None:
         ax.axvline(required, color="k", ls="--", lw=0.9, label=f"requirement {required:.4g}")

@@ -98,8 +98,9 @@ class ReportSpec(StrictModel):
 
 class TradeoffSpec(FiniteModel):
     """One constraint sweep: a constraint output (g = its f_k ≤ ε), the ``hunting`` check (the constrained
-    problem with its stability rows up to each required speed ε, m/s, and the critical speed confirmed), or
-    another check (value ≥ ε, derivative-free)."""
+    problem with its stability rows up to each required speed ε, m/s, and the critical speed confirmed),
+    ``damping`` (the constrained problem with every vehicle mode at least ε damped, ζ_min = ε, up to the required
+    speed: what each per cent of damping costs in U), or another check (value ≥ ε, derivative-free)."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     output: str | None = None
@@ -121,7 +122,7 @@ class TradeoffSpec(FiniteModel):
     def _one(self) -> TradeoffSpec:
         if (self.output is None) == (self.check is None):
             raise ValueError(f"tradeoffs.{self.name}: give exactly one of output or check")
-        if self.check not in (None, "hunting") and self.method != "cobyla":
+        if self.check not in (None, "hunting", "damping") and self.method != "cobyla":
             raise ValueError(f"tradeoffs.{self.name}.method: a check is not differentiable; use method = 'cobyla'")
         return self
 
@@ -209,9 +210,10 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
         if bad:
             raise ValueError(f"{field}: {bad} are not outputs of {where}; outputs are {list(outputs)}")
     for t in cfg.tradeoffs:
-        if t.check is not None and t.check not in setup.checks:
-            raise ValueError(f"tradeoffs.{t.name}.check: {where} has no check {t.check!r}")
-        if t.check == "hunting" and not setup.stability:
+        needed = "hunting" if t.check == "damping" else t.check
+        if needed is not None and needed not in setup.checks:
+            raise ValueError(f"tradeoffs.{t.name}.check: {where} has no check {needed!r}")
+        if t.check in ("hunting", "damping") and not setup.stability:
             raise ValueError(f"tradeoffs.{t.name}.check: {where} has no stability family to sweep against")
     for i, c in enumerate(cfg.constraints):
         if c.clearance is not None and c.clearance not in setup.limits:

@@ -4,7 +4,7 @@ the starts, and the problems and quantities of the trade-off sweeps and surfaces
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -13,7 +13,7 @@ from railopt.studies.adapter import minimax_problem, response_target, rms_target
 from railopt.studies.catalog import Check, ModelSetup
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig, ConstraintSpec, StabilitySpec, TradeoffSpec
 
-__all__ = ["campaign_label", "campaign_problem", "design_peak"]
+__all__ = ["FeasibleDesign", "campaign_label", "campaign_problem", "design_peak"]
 
 
 def campaign_label(model: str, objective: str, method: str, problem: str = "constrained") -> str:
@@ -83,6 +83,10 @@ def _sweep_problems(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str,
         elif spec.check == "hunting":
             stable = cfg if cfg.stability is not None else cfg.model_copy(update={"stability": StabilitySpec()})
             problem = campaign_problem(stable, setup, objective, "constrained", required_speed=e)
+        elif spec.check == "damping":
+            base = cfg.stability or StabilitySpec()
+            damped = cfg.model_copy(update={"stability": base.model_copy(update={"zeta_min": float(e)})})
+            problem = campaign_problem(damped, setup, objective, "constrained")
         else:
             check, names = setup.checks[spec.check], [v.name for v in cfg.design.variables]
             problem = campaign_problem(cfg, setup, objective, "unconstrained").with_constraints(
@@ -115,8 +119,37 @@ class _DesignValues:
     def __call__(self, x: np.ndarray) -> np.ndarray:
         names = [v.name for v in self.cfg.design.variables]
         p, _ = self.setup.parameters(names, np.asarray(x, dtype=float))
-        out = [self.setup.checks["hunting"](p).value] if self.hunting else []
+        check = self.setup.checks["hunting"] if self.hunting else None
+        out = [] if check is None else [check.critical_speed(p) if hasattr(check, "critical_speed") else check(p).value]
         return np.array(out + [c["peak"] for c in _constraint_peaks(self.cfg, self.setup, p)])
+
+
+@dataclass(frozen=True)
+class FeasibleDesign:
+    """Whether a design x meets every constraint of the constrained problem but the one ``spec`` trades: each other
+    ``[[constraints]]`` output within its limit (certified peak, to 1e-9 of the limit) and, unless the critical
+    speed is the traded quantity, the ``[stability]`` criterion certified by the hunting check (``stable``).  A
+    trade-off front holds only such designs.  ``spec`` None: every constraint, the whole criterion (a design the
+    study could recommend)."""
+
+    cfg: CampaignStudyConfig
+    setup: ModelSetup
+    spec: TradeoffSpec | None
+
+    def __call__(self, x: np.ndarray) -> bool:
+        names = [v.name for v in self.cfg.design.variables]
+        p, _ = self.setup.parameters(names, np.asarray(x, dtype=float))
+        traded = None if self.spec is None else self.spec.output
+        kind = None if self.spec is None else self.spec.check
+        for c in _constraint_peaks(self.cfg, self.setup, p):
+            if c["output"] != traded and not c["peak"] <= c["limit"] * (1 + 1e-9):
+                return False
+        if self.cfg.stability is not None and kind != "hunting" and "hunting" in self.setup.checks:
+            check = self.setup.checks["hunting"]
+            if kind == "damping":  # the damping ratio is the traded quantity: the rest of the criterion
+                check = replace(check, zeta_min=0.0)
+            return bool(check(p).flags["stable"])
+        return True
 
 
 def _quantity(cfg: CampaignStudyConfig, setup: ModelSetup, spec: TradeoffSpec):
@@ -126,6 +159,9 @@ def _quantity(cfg: CampaignStudyConfig, setup: ModelSetup, spec: TradeoffSpec):
         p, _ = setup.parameters(names, x)
         if spec.output is not None:
             return setup.family.at(p).peak(band_hz=cfg.objective.band_hz, exact=spec.exact, output=spec.output)
+        if spec.check == "damping":  # the least damping ratio over the tracks, up to the required speed
+            data = setup.checks["hunting"](p).data
+            return min(v for k, v in data.items() if k.startswith("least_damping_") and not k.endswith("_m_s"))
         return setup.checks[spec.check](p).value
 
     return value

@@ -120,20 +120,43 @@ def _tradeoff(result: CampaignResult, s: ModelSections, t: Tradeoff, writer: Wri
     writer.figure(plot_tradeoff(t.table, q, f"{s.model}: U against {q} ({spec.name})", required=t.required),
                   f"pareto_{stem}", dpi=result.config.report.dpi)
     how = ("the constrained problem solved with the stability rows required up to each speed"
-           if spec.check == "hunting" else f"the constrained problem solved at each limit of {spec.output}"
+           if spec.check == "hunting" else "the constrained problem solved with every vehicle mode at least ζ_min "
+           "damped up to the required speed, at each ζ_min" if spec.check == "damping"
+           else f"the constrained problem solved at each limit of {spec.output}"
            if spec.output else f"the {spec.check} check held above each value")
+    missed = int((~t.table["feasible"]).sum()) if "feasible" in t.table.columns else 0
     md = [f"Trade-off `{spec.name}` ({how}; targets {', '.join(f'{e:g}' for e in spec.epsilons)}): "
-          f"{len(t.front)} non-dominated designs among {len(t.table)} distinct designs (sweep optima and every "
-          f"start; `count` = how many identical designs each row stands for); `pareto_{stem}.csv`:", "",
+          f"{len(t.front)} non-dominated designs among the {len(t.table) - missed} of {len(t.table)} distinct "
+          f"designs (sweep optima and every start; `count` = how many identical designs each row stands for) that "
+          f"meet every other constraint of the constrained problem ({_others(result, spec)}); the {missed} that do "
+          f"not are listed in `tradeoff_{stem}.csv` (`feasible` False) and drawn apart; `pareto_{stem}.csv`:", "",
           markdown_table(t.front[["source", "count", "U", q, *names]].head(12), digits=5), ""]
     if t.required is not None:
         sense = "≥" if spec.check is not None else "≤"
         if t.pick is not None:
-            md += [f"Best design of the front with {q} {sense} {t.required:.4g}: U = {t.pick['U']:.5g}, "
-                   f"{q} = {t.pick[q]:.4g}.", ""]
+            md += [f"Best design with {q} {sense} {t.required:.4g} that meets every constraint and the whole "
+                   f"stability criterion: U = {t.pick['U']:.5g}, {q} = {t.pick[q]:.4g}.", ""]
+            rec = s.recommended
+            if rec is not None and t.pick["U"] < rec.U * (1 - 1e-6):
+                md += [f"**It beats the recommended design (U = {rec.U:.5g})**, which is the best certified optimum "
+                       "of the constrained campaigns: the sweep found a better certified design than the campaign's "
+                       "starts; raise `design.n_starts` (the recommendation is kept from the campaigns).", ""]
+            elif rec is not None:
+                md += [f"The recommended design (U = {rec.U:.5g}) is at least as good: no certified design of the "
+                       "sweep or the starts beats it.", ""]
         else:
-            md += [f"No design of the front has {q} {sense} {t.required:.4g}.", ""]
+            md += [f"No design with {q} {sense} {t.required:.4g} meets every constraint and the whole stability "
+                   "criterion.", ""]
     return md
+
+
+def _others(result: CampaignResult, spec) -> str:
+    """The constraints a front design must meet besides the traded one, in words."""
+    cfg = result.config
+    parts = [f"{c.output} within its limit" for c in cfg.constraints if c.output != spec.output]
+    if cfg.stability is not None and spec.check != "hunting":
+        parts.append("the stability criterion, certified")
+    return ", ".join(parts) or "none"
 
 
 def tradeoffs_section(result: CampaignResult, s: ModelSections, writer: Writer) -> list[str]:
@@ -204,7 +227,7 @@ def recommended_section(result: CampaignResult, writer: Writer) -> list[str]:
             rec.existing_U / ref["U"] if rec.existing_U and ref is not None else None)
         for name, payload in rec.checks.items():
             for key, value in payload.items():
-                if isinstance(value, bool) or key.startswith("least_damping"):
+                if isinstance(value, bool):
                     continue
                 ex_check = result.existing_checks.get(s.model, {}).get(name, {})
                 ref_value = None if ref is None else ref["checks"][name].payload().get(key)

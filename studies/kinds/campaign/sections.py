@@ -15,6 +15,7 @@ from railopt.studies.adapter import response_target
 from railopt.studies.catalog import ModelSetup
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
 from railopt.studies.kinds.campaign.problems import (
+    FeasibleDesign,
     _DesignValues,
     _p,
     _quantity,
@@ -200,20 +201,23 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
         best = pd.Series({**after, "true_peak": recommended.U, **recommended.source})
     band = response_target(cfg.objective, setup, exact=True).band
     before_after = _before_after(cfg, setup, after, band) if cfg.report.before else None
-    starts = pd.concat([t for (m, _, o, _), t in tables.items() if m == model])
+    starts = pd.concat([t.assign(problem=prob) for (m, prob, o, _), t in tables.items() if m == model])
     x_after = np.array([after[n] for n in names])
     tradeoffs = []
     for spec in cfg.tradeoffs:
         required = None
         if spec.check == "hunting":
             required = (cfg.stability.required(setup) if cfg.stability is not None else setup.required_speed)
+        elif spec.check == "damping":
+            required = cfg.stability.zeta_min if cfg.stability is not None else None
         elif spec.output is not None:
             limits = [c.limit_value(setup) for c in cfg.constraints if c.output == spec.output]
             required = limits[0] if limits else None
         tradeoffs.append(tradeoff_table(
             spec, _sweep_problems(cfg, setup, objective, spec), starts, _quantity(cfg, setup, spec),
             lambda x: design_peak(cfg, setup, dict(zip(names, x, strict=True))), cfg.design.seed,
-            points=[list(x_after)], client=client, required=required))
+            points=[list(x_after)], client=client, required=required, feasible=FeasibleDesign(cfg, setup, spec),
+            criterion=(FeasibleDesign(cfg, setup, None) if spec.check in ("hunting", "damping") else None)))
     reference = _unconstrained_best(cfg, setup, model, tables)
     marks = {"recommended" if recommended is not None else "optimum": after}
     if reference is not None:

@@ -5,7 +5,8 @@ stroke held below ε (an output constraint), or the stability rows of SPEC §2.5
 (``check = "hunting"``, the critical speed confirmed afterwards by the hunting check) — so the front has no
 gap where feasible designs exist.  The sweep optima and every start of the campaign are merged into one
 table of distinct designs (identical designs counted once, with ``count``), and ``nondominated`` marks the
-front of (U, traded quantity).
+front of (U, traded quantity) among the designs that meet every other constraint of the constrained problem
+(``feasible``: the certified stability criterion, the other output limits); the rest are listed and drawn apart.
 
 ``[[surfaces]]``: U over a grid of two design variables with the others at the recommended design, inside the
 bounds (constrained) and on a grid relaxed toward zero (unconstrained), where the thesis notes the trivial
@@ -86,25 +87,48 @@ def distinct_designs(designs: pd.DataFrame, problem: MinimaxProblem) -> pd.DataF
 def tradeoff_table(spec: TradeoffSpec, problems: Sequence[tuple[float, MinimaxProblem]], starts: pd.DataFrame,
                    quantity: Callable[[np.ndarray], float], objective: Callable[[np.ndarray], float], seed: int,
                    points: Sequence[Sequence[float]] | None = None, client=None,
-                   required: float | None = None) -> Tradeoff:
+                   required: float | None = None,
+                   feasible: Callable[[np.ndarray], bool] | None = None,
+                   criterion: Callable[[np.ndarray], bool] | None = None) -> Tradeoff:
     """The sweep of ``spec`` over its targets, merged with the campaign's starts; U (``objective``, certified) and
     the traded ``quantity`` of every distinct design; the front; and, with ``required``, the best front design
-    whose quantity meets it."""
+    whose quantity meets it.
+
+    ``feasible(x)`` says whether a design meets every constraint of the constrained problem other than the traded
+    one (the stability criterion certified by the hunting check, the other output limits): the front holds only
+    feasible designs; the others stay in the table (``feasible`` False: unconstrained starts, designs that hunt)
+    and are drawn apart.  ``starts`` may carry ``problem`` ("constrained"/"unconstrained"), kept as ``source``.
+    The pick (with ``required``) is the best feasible design whose quantity meets it (to 1e-6 relative) and, with
+    ``criterion(x)`` (the whole stability criterion, when the traded quantity is part of it), meets that too: a
+    design the study could recommend, comparable with its recommendation.
+    """
     names = list(problems[0][1].space.names)
     swept = sweep(problems, spec, seed, points, client)
+    ok = starts[np.isfinite(starts["value"])]
+    kinds = ok["problem"].astype(str) if "problem" in ok.columns else pd.Series("", index=ok.index)
     designs = pd.concat([swept[swept["success"]][names].assign(source="sweep"),
-                         starts[np.isfinite(starts["value"])][names].assign(source="start")], ignore_index=True)
+                         ok[names].assign(source=("start " + kinds).str.strip())], ignore_index=True)
     table = distinct_designs(designs, problems[0][1])
-    name = spec.output or "critical_speed_m_s"
+    name = spec.output or ("least_damping_ratio" if spec.check == "damping" else "critical_speed_m_s")
     table["U"] = [objective(x) for x in table[names].to_numpy(float)]
     table[name] = [quantity(x) for x in table[names].to_numpy(float)]
     table = table[np.isfinite(table["U"])].reset_index(drop=True)
+    table["feasible"] = [bool(feasible(x)) if feasible is not None else True for x in table[names].to_numpy(float)]
     at_least = spec.check is not None
-    table["nondominated"] = nondominated(table, ["U", name], {"U": "min", name: "max" if at_least else "min"})
+    front_mask = np.zeros(len(table), dtype=bool)
+    candidates = table[table["feasible"]]
+    if len(candidates):
+        front_mask[candidates.index.to_numpy()] = nondominated(candidates, ["U", name],
+                                                    {"U": "min", name: "max" if at_least else "min"}).to_numpy()
+    table["nondominated"] = front_mask
     front = table[table["nondominated"]].sort_values("U").reset_index(drop=True)
     pick = None
     if required is not None:
-        meets = front[front[name] >= required] if at_least else front[front[name] <= required]
+        slack = 1e-6 * abs(required)
+        ok = table["feasible"] & ((table[name] >= required - slack) if at_least else (table[name] <= required + slack))
+        meets = table[ok]
+        if criterion is not None and len(meets):
+            meets = meets[[bool(criterion(x)) for x in meets[names].to_numpy(float)]]
         pick = meets.sort_values("U").iloc[0] if len(meets) else None
     return Tradeoff(spec, table, front, name, required, pick)
 
