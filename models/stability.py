@@ -49,6 +49,7 @@ from railopt.models.stability_map import (
     StabilityInterval,
     StabilityMap,
     abscissa,
+    checked_speed_range,
     resolve_model,
     stability_map,
     worst_speed,
@@ -213,19 +214,6 @@ class CriticalSpeed:
                               "certified": self.certified}])
 
 
-def _speed_range(speed_range: object) -> tuple[float, float]:
-    try:
-        pair = list(speed_range)  # type: ignore[call-overload]
-    except TypeError:
-        pair = None
-    if pair is None or len(pair) != 2:
-        raise ValueError(f"speed_range: must be a pair (lowest, highest) of speeds in m/s, got {speed_range!r}")
-    lo, hi = (number(f"speed_range[{i}]", v, positive=True) for i, v in enumerate(pair))
-    if not hi > lo:
-        raise ValueError(f"speed_range: inverted or empty range ({lo}, {hi}) m/s")
-    return lo, hi
-
-
 def critical_speed(
     model: StabilityModel,
     track: str | None = None,
@@ -262,7 +250,7 @@ def critical_speed(
     ValueError
         A bad ``speed_range``, ``tol`` or ``grid`` (naming it), or a model without ``at(speed=S)``.
     """
-    lo, hi = _speed_range(speed_range)
+    lo, hi = checked_speed_range(speed_range)
     tol = number("tol", tol, positive=True)
     if isinstance(grid, bool) or not isinstance(grid, numbers.Integral) or grid < 2:
         raise ValueError(f"grid: must be an integer number of bracketing speeds ≥ 2, got {grid!r}")

@@ -34,6 +34,20 @@ from railopt.models.validation import number
 SAMPLED_GRID = 64  # speeds of the scan of a family without a pencil
 
 
+def checked_speed_range(speed_range: object) -> tuple[float, float]:
+    """``(lowest, highest)`` forward speeds (m/s) of a range, checked (ValueError naming ``speed_range``)."""
+    try:
+        pair = list(speed_range)  # type: ignore[call-overload]
+    except TypeError:
+        pair = None
+    if pair is None or len(pair) != 2:
+        raise ValueError(f"speed_range: must be a pair (lowest, highest) of speeds in m/s, got {speed_range!r}")
+    lo, hi = (number(f"speed_range[{i}]", v, positive=True) for i, v in enumerate(pair))
+    if not hi > lo:
+        raise ValueError(f"speed_range: inverted or empty range ({lo}, {hi}) m/s")
+    return lo, hi
+
+
 def abscissa(s: np.ndarray) -> float:
     """max Re s over the roots that are not neutral rigid-body roots (|s| ≤ 1e-8 max|s| counts as s = 0)."""
     scale = float(np.max(np.abs(s))) if s.size else 0.0
@@ -191,9 +205,7 @@ def stability_map(model: StabilityModel, speed_range: tuple[float, float] = (1.0
     ValueError
         A bad ``speed_range``, ``sigma`` or ``tol`` (naming it), or a model without ``at(speed=S)``.
     """
-    from railopt.models.stability import _speed_range  # the one range check (stability imports this module)
-
-    lo, hi = _speed_range(speed_range)
+    lo, hi = checked_speed_range(speed_range)
     sigma = number("sigma", sigma)
     tol = number("tol", tol, positive=True)
     family = CountedFamily(model, track)
@@ -333,5 +345,5 @@ def least_damping_ratio(model: StabilityModel, speed_range: tuple[float, float],
     return float(values[k]), float(speeds[k])
 
 
-__all__ = ["SAMPLED_GRID", "CountedFamily", "StabilityInterval", "StabilityMap", "abscissa", "least_damping_ratio",
-           "resolve_model", "stability_map", "worst_speed"]
+__all__ = ["SAMPLED_GRID", "CountedFamily", "StabilityInterval", "StabilityMap", "abscissa", "checked_speed_range",
+           "least_damping_ratio", "resolve_model", "stability_map", "worst_speed"]

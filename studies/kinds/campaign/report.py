@@ -185,6 +185,20 @@ def _surface(result: CampaignResult, s: ModelSections, g: TradeoffSurfaces, writ
         best = float(np.min(inside)) if np.isfinite(np.min(inside)) else float("nan")
         md[-1] += (f" {bd.label} ({bd.limit:.4g}) is drawn on the constrained panel; {int(feasible.sum())} of "
                    f"{feasible.size} grid points meet it (least U among them {best:.4g}).")
+    if s.recommended is not None:
+        rec = s.recommended.U
+        if g.below_certified:
+            d = g.below_certified[0]
+            md[-1] += (f" **A grid point beats the recommended design (U = {rec:.5g}) and meets every constraint and "
+                       f"the whole stability criterion: U = {d['U']:.5g} at {a} = {d[a]:.4g}, {b} = {d[b]:.4g}** — "
+                       "the campaign's starts missed it; raise `design.n_starts` (the recommendation is kept from "
+                       "the campaigns).")
+        elif g.below:
+            md[-1] += (f" {len(g.below)} grid point(s) with U below the recommended design's {rec:.5g} meet the drawn "
+                       "boundaries, but none of them meets the whole stability criterion (certified decay rate and "
+                       "damping ratio at every speed): the recommendation stands.")
+        else:
+            md[-1] += f" No grid point meeting the drawn boundaries has U below the recommended design's {rec:.5g}."
     return md + ["", f"![surfaces]({stem}.png)", ""]
 
 

@@ -24,7 +24,13 @@ from railopt.studies.kinds.campaign.problems import (
     design_peak,
 )
 from railopt.studies.kinds.campaign.selection import Recommended, _active_bounds, _unconstrained_best
-from railopt.studies.kinds.campaign.tradeoffs import Tradeoff, TradeoffSurfaces, surfaces, tradeoff_table
+from railopt.studies.kinds.campaign.tradeoffs import (
+    Tradeoff,
+    TradeoffSurfaces,
+    grid_points_below,
+    surfaces,
+    tradeoff_table,
+)
 from railopt.studies.output.records import FrfPanel
 
 __all__ = ["BeforeAfter", "ModelSections"]
@@ -232,4 +238,6 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
     grids = [surfaces(problem, spec, x_after, client, _DesignValues(cfg, setup, hunting), limits, marks,
                       units=(*(setup.parameter_map.unit(v) for v in spec.variables), u_unit))
              for spec in cfg.surfaces]
+    if recommended is not None:  # grid points that beat the recommendation: do they meet everything?
+        grids = [grid_points_below(g, after, recommended.U, FeasibleDesign(cfg, setup, None), names) for g in grids]
     return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids, recommended, reference)

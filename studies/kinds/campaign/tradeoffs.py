@@ -17,7 +17,7 @@ so the figure draws the constraint boundaries.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -26,7 +26,8 @@ from railopt.design import MinimaxProblem, Surface, grid_map, multistart, nondom
 from railopt.studies.kinds.campaign.config import SurfaceSpec, TradeoffSpec
 from railopt.studies.output.records import Boundary
 
-__all__ = ["Boundary", "Tradeoff", "TradeoffSurfaces", "distinct_designs", "surfaces", "sweep", "tradeoff_table"]
+__all__ = ["Boundary", "Tradeoff", "TradeoffSurfaces", "distinct_designs", "grid_points_below", "surfaces", "sweep",
+           "tradeoff_table"]
 
 DISTINCT_DIGITS = 6  # designs equal to 1e-6 of their unit-cube coordinates are one design
 
@@ -55,6 +56,26 @@ class TradeoffSurfaces:
     boundaries: list[Boundary] = field(default_factory=list)
     marks: dict[str, dict[str, float]] = field(default_factory=dict)
     units: tuple[str, str, str] = ("", "", "")  # of the two variables and of U (figure axes)
+    below: list[dict[str, float]] = field(default_factory=list)  # grid points under U_ref meeting every boundary
+    below_certified: list[dict[str, float]] = field(default_factory=list)  # ... of them, those meeting everything
+
+
+def grid_points_below(g: TradeoffSurfaces, base: dict[str, float], U_ref: float,
+                      feasible: Callable[[np.ndarray], bool], names: Sequence[str],
+                      most: int = 12) -> TradeoffSurfaces:
+    """The constrained grid's points with U below ``U_ref`` (to 1e-6) inside the bounds that meet every drawn
+    boundary, and which of them (the ``most`` lowest) meet every constraint and the whole criterion
+    (``feasible``): a grid point that beats the recommendation must be said so, with why it is not recommended."""
+    surface = g.constrained
+    ok = surface.inside & (surface.values < U_ref * (1 - 1e-6))
+    for bd in g.boundaries:
+        ok &= bd.values >= bd.limit if bd.at_least else bd.values <= bd.limit
+    js, is_ = np.nonzero(ok)
+    order = np.argsort(surface.values[js, is_])[:most]
+    below = [{**base, surface.names[0]: float(surface.xi[is_[k]]), surface.names[1]: float(surface.xj[js[k]]),
+              "U": float(surface.values[js[k], is_[k]])} for k in order]
+    certified = [d for d in below if feasible(np.array([d[n] for n in names]))]
+    return replace(g, below=below, below_certified=certified)
 
 
 def sweep(problems: Sequence[tuple[float, MinimaxProblem]], spec: TradeoffSpec, seed: int,
