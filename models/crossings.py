@@ -23,6 +23,7 @@ the margin between consecutive candidates (:mod:`railopt.models.stability_map`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,11 +144,57 @@ def crossing_speeds(pencil: SpeedPencil, speed_range: tuple[float, float], sigma
     if N == 0:
         return np.zeros(0)
     shifted = pencil.A + sigma * np.eye(N)
-    u = np.concatenate([_pencil_values(bialternate(shifted), bialternate(pencil.B)),
+    u = np.concatenate([bialternate_values(shifted, pencil.B, 1.0 / math.sqrt(lo * hi)),
                         _pencil_values(shifted, pencil.B)])
     u = u[(u > 0.0)]
     S = np.sort(1.0 / u)
     return S[(S >= lo * (1 - SPEED_SLACK)) & (S <= hi * (1 + SPEED_SLACK))]
+
+
+def bialternate_factors(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``L`` (m, rN) and ``R`` (rN, m) with 2B⊙I = L R, r = rank B (B = Ub Vbᵀ).
+
+    On antisymmetric X, B X + X Bᵀ = Z − Zᵀ with Y = Vbᵀ X (r, N) and Z = Ub Y, since X Vb = −(Vbᵀ X)ᵀ: R maps
+    the coordinates of X to Y, L maps Y to the coordinates (p > q) of Z − Zᵀ.  The creep term B has the rank of
+    C_speed (two per wheelset), so rN is well below m = N(N−1)/2.
+    """
+    N = B.shape[0]
+    U_, sv, Vt = np.linalg.svd(B)
+    r = int(np.sum(sv > RANK_RTOL * sv[0])) if sv.size and sv[0] > 0 else 0
+    Ub, Vb = U_[:, :r] * sv[:r], Vt[:r].T
+    P, Q = np.tril_indices(N, -1)
+    c = np.arange(P.size)
+    R = np.zeros((r * N, P.size))
+    L = np.zeros((P.size, r * N))
+    for k in range(r):
+        R[k * N + Q, c] += Vb[P, k]
+        R[k * N + P, c] -= Vb[Q, k]
+        L[c, k * N + Q] += Ub[P, k]
+        L[c, k * N + P] -= Ub[Q, k]
+    return L, R
+
+
+def bialternate_values(A: np.ndarray, B: np.ndarray, u0: float) -> np.ndarray:
+    """The real finite u with det(2(A + uB)⊙I) = 0, by the low rank of 2B⊙I = L R.
+
+    Shifted at u0 (M0 = 2(A + u0 B)⊙I, nonsingular unless a crossing sits at u0: another shift is tried, then QZ),
+    (M0 + (u − u0) L R) v = 0 ⇔ the eigenvalues λ of R M0⁻¹ L (rN × rN) give u = u0 − 1/λ: an LU of size m and an
+    eigenproblem of size rN instead of the QZ of size m (the results agree with :func:`_pencil_values`, tested).
+    """
+    if A.shape[0] < 2:
+        return np.zeros(0)
+    L, R = bialternate_factors(B)
+    if R.shape[0] == 0:
+        return np.zeros(0)
+    for shift in (u0, 0.7 * u0, 1.9 * u0):
+        lu, piv = sla.lu_factor(bialternate(A + shift * B), check_finite=False)
+        pivots = np.abs(np.diag(lu))
+        if np.min(pivots) > 1e-10 * np.max(pivots):
+            lam = np.linalg.eigvals(R @ sla.lu_solve((lu, piv), L, check_finite=False))
+            lam = lam[np.abs(lam) > 1e-12 * max(float(np.max(np.abs(lam))), 1e-300)]
+            u = shift - 1.0 / lam
+            return u[np.abs(u.imag) <= REAL_RTOL * np.abs(u)].real
+    return _pencil_values(bialternate(A), bialternate(B))
 
 
 def _pencil_values(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -165,5 +212,5 @@ def _pencil_values(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return u[real].real
 
 
-__all__ = ["RANK_RTOL", "REAL_RTOL", "SPEED_SLACK", "SpeedPencil", "bialternate", "crossing_speeds", "declares_creep",
-           "speed_pencil"]
+__all__ = ["RANK_RTOL", "REAL_RTOL", "SPEED_SLACK", "SpeedPencil", "bialternate", "bialternate_factors",
+           "bialternate_values", "crossing_speeds", "declares_creep", "speed_pencil"]

@@ -271,3 +271,25 @@ def test_coach_designs_equal_a_dense_scan() -> None:
     vehicle = load_vehicle("manchester-coach")
     for design in _designs(vehicle, COACH_PARAMETERS, 6, 0, seed=21):
         _check_against_scan(vehicle.with_parameters(design).lateral(track="rigid"), 1.0, 120.0)
+
+
+def test_the_low_rank_pencil_equals_the_qz_of_the_full_bialternate_pencil() -> None:
+    """2B⊙I = L R exactly, and the candidate u from the rank-rN eigenproblem equal those of a QZ of size m, on a random
+    low-rank pencil and on the locomotive's flexible-track pencil."""
+    from railopt.models.crossings import _pencil_values, bialternate_factors, bialternate_values
+
+    rng = np.random.default_rng(4)
+    N, r = 10, 3
+    A = rng.standard_normal((N, N))
+    B = rng.standard_normal((N, r)) @ rng.standard_normal((r, N))
+    L, R = bialternate_factors(B)
+    assert L.shape == (N * (N - 1) // 2, r * N)
+    np.testing.assert_allclose(L @ R, bialternate(B), atol=1e-12 * np.max(np.abs(bialternate(B))))
+    pen = speed_pencil(load_vehicle("sd40-2").lateral(track="flexible").at(speed=30.0))
+    for A_, B_ in ((A, B), (pen.A, pen.B)):
+        qz = np.sort(_pencil_values(bialternate(A_), bialternate(B_)))
+        low = np.sort(bialternate_values(A_, B_, 0.05))
+        # QZ also returns numerically infinite eigenvalues (|u| ~ 1e7–1e11, tiny β): compare speeds above 1 mm/s
+        qz, low = qz[np.abs(qz) < 1e3], low[np.abs(low) < 1e3]
+        assert len(low) == len(qz)
+        np.testing.assert_allclose(low, qz, rtol=1e-7)
