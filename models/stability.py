@@ -256,7 +256,7 @@ def critical_speed(
         raise ValueError(f"grid: must be an integer number of bracketing speeds ≥ 2, got {grid!r}")
     counted = _Counted(model, track)
     if declares_creep(counted.at(0.5 * (lo + hi))):
-        return _certified_critical(model, track, lo, hi, tol)
+        return _certified_critical(counted.model, lo, hi, tol)  # resolved once (a vehicle's view is assembled)
     found, bracket = first_crossing(counted, lo, hi, tol, int(grid))
     if found == lo and bracket == (lo, lo):
         f, mode, coordinate = _critical_root(counted, lo)
@@ -267,10 +267,10 @@ def critical_speed(
     return CriticalSpeed(found, f, mode, counted.solves, bracket, False, tol, coordinate)
 
 
-def _certified_critical(model: StabilityModel, track: str | None, lo: float, hi: float, tol: float) -> CriticalSpeed:
-    """The critical speed read from the certified map (σ = 0)."""
-    smap = stability_map(model, (lo, hi), track=track, tol=tol)
-    counted = _Counted(model, track)
+def _certified_critical(model: SpeedFamily, lo: float, hi: float, tol: float) -> CriticalSpeed:
+    """The critical speed read from the certified map (σ = 0) of a resolved model."""
+    smap = stability_map(model, (lo, hi), tol=tol)
+    counted = _Counted(model, None)
     first = smap.intervals[0]
     if not first.stable:
         f, mode, coordinate = _critical_root(counted, lo)
@@ -334,12 +334,7 @@ def _critical_root(counted: _Counted, speed: float) -> tuple[float, str, str]:
 def least_damping(model: StabilityModel, speeds: Sequence[float], track: str | None = None) -> float:
     """Smallest damping ratio −Re s/|s| over the roots at ``speeds`` (m/s; neutral roots s ≈ 0 skipped)."""
     counted = _Counted(model, track)
-    worst = math.inf
-    for S in forward_speeds(speeds):
-        s = counted.roots(float(S))
-        live = s[np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s))]
-        worst = min(worst, float(np.min(-live.real / np.abs(live))))
-    return worst
+    return min((counted.least_damping(float(S)) for S in forward_speeds(speeds)), default=math.inf)
 
 
 

@@ -87,6 +87,12 @@ class CountedFamily:
     def __call__(self, speed: float) -> float:
         return abscissa(self.roots(speed))
 
+    def least_damping(self, speed: float) -> float:
+        """The least damping ratio −Re s/|s| of the non-neutral roots at ``speed`` (one eigen-solve; inf if none)."""
+        s = self.roots(float(speed))
+        live = s[np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s))]
+        return float(np.min(-live.real / np.abs(live))) if live.size else math.inf
+
     def margin(self, speed: float, sigma: float) -> float:
         """a(S) + σ, 1/s: positive where a root lies right of Re s = −σ."""
         return self(speed) + sigma
@@ -105,8 +111,9 @@ class CountedFamily:
 
 @dataclass(frozen=True)
 class StabilityInterval:
-    """One interval of a :class:`StabilityMap`: ``start``–``end`` (m/s), ``stable`` throughout, the margin
-    a(S) + σ read at its middle (1/s), and the mode that crosses at each end ("" at an end of the range)."""
+    """One interval of a :class:`StabilityMap`: ``start``–``end`` (m/s), ``stable`` throughout, the largest margin
+    a(S) + σ read in it (at the middles between candidates, 1/s), and the mode that crosses at each end ("" at an
+    end of the range)."""
 
     start: float
     end: float
@@ -223,10 +230,8 @@ def stability_map(model: StabilityModel, speed_range: tuple[float, float] = (1.0
         candidates = tuple(float(c) for c in cands)
         inner = [c for c in candidates if lo < c < hi]
         points, method, size = [lo, *_merge(inner, tol / 4), hi], "pencil", pencil.bialternate_size
-    intervals, confirmed = _intervals(family, points, sigma, tol)
+    intervals = _intervals(family, points, sigma, tol)
     ends_agree = _ends_agree(family, intervals, lo, hi, sigma, tol)
-    if method == "pencil" and not note and not confirmed:
-        note = "a crossing could not be confirmed within tol"
     if method == "pencil" and not note and not ends_agree:
         note = "the margin at an end of the range disagrees with the map"
     certified = method == "pencil" and not note
@@ -242,46 +247,36 @@ def _merge(speeds: list[float], gap: float) -> list[float]:
     return out
 
 
-def _intervals(family: CountedFamily, points: list[float], sigma: float, tol: float
-               ) -> tuple[list[StabilityInterval], bool]:
-    """Read each interval's state at its middle, merge equal neighbours, confirm each crossing within tol."""
-    raw = []
-    for a, b in zip(points[:-1], points[1:], strict=True):
-        m = family.margin(0.5 * (a + b), sigma)
-        raw.append([a, b, m <= 0.0, m])
-    merged: list[list] = []
-    for a, b, stable, m in raw:
-        if merged and merged[-1][2] == stable:
-            merged[-1][1] = b
-            merged[-1][3] = max(merged[-1][3], m)
+def _intervals(family: CountedFamily, points: list[float], sigma: float, tol: float) -> list[StabilityInterval]:
+    """Read each piece's state at its middle, merge equal neighbours, and locate each crossing within tol.
+
+    Where two neighbouring pieces differ, their middles bracket the crossing (the margin changes sign between them),
+    so the candidate between them is confirmed by two eigen-solves within ±tol/2, or else the crossing is located by
+    Brent between the middles to ``tol``: a state change is always located by eigen-solves.
+    """
+    mids = [0.5 * (a + b) for a, b in zip(points[:-1], points[1:], strict=True)]
+    margins = [family.margin(m, sigma) for m in mids]
+    stable = [m <= 0.0 for m in margins]
+    merged = [[points[0], points[1], stable[0], margins[0]]]
+    for i in range(1, len(mids)):
+        if stable[i] == merged[-1][2]:
+            merged[-1][1], merged[-1][3] = points[i + 1], max(merged[-1][3], margins[i])
         else:
-            merged.append([a, b, stable, m])
-    confirmed = True
-    mids = {(a, b): 0.5 * (a + b) for a, b, _, _ in raw}
-    for k in range(1, len(merged)):
-        c = merged[k][0]
-        left_mid = max(mid for (a, b), mid in mids.items() if b <= c)
-        right_mid = min(mid for (a, b), mid in mids.items() if a >= c)
-        crossing, ok = _confirm(family, c, left_mid, right_mid, merged[k][2], sigma, tol)
-        confirmed &= ok
-        merged[k - 1][1] = merged[k][0] = crossing
-    return [StabilityInterval(a, b, bool(s), float(m)) for a, b, s, m in merged], confirmed
+            crossing = _confirm(family, points[i], mids[i - 1], mids[i], stable[i], sigma, tol)
+            merged[-1][1] = crossing
+            merged.append([crossing, points[i + 1], stable[i], margins[i]])
+    return [StabilityInterval(a, b, bool(st), float(m)) for a, b, st, m in merged]
 
 
 def _confirm(family: CountedFamily, c: float, left: float, right: float, stable_after: bool, sigma: float,
-             tol: float) -> tuple[float, bool]:
+             tol: float) -> float:
     """The crossing near candidate ``c``: its sign change checked within ±tol/2, else located by Brent between
-    the neighbouring interval middles (where the states were read) to ``tol``."""
+    the neighbouring middles ``left`` and ``right`` (whose states differ) to ``tol``."""
     half = 0.5 * tol
     a, b = max(c - half, left), min(c + half, right)
-    ma, mb = family.margin(a, sigma), family.margin(b, sigma)
-    if (ma <= 0.0) != stable_after and (mb <= 0.0) == stable_after:
-        return c, True
-    fl, fr = family.margin(left, sigma), family.margin(right, sigma)
-    if (fl <= 0.0) == (fr <= 0.0):
-        return c, False
-    root = brentq(lambda S: family.margin(S, sigma), left, right, xtol=tol, rtol=4 * np.finfo(float).eps)
-    return float(root), True
+    if (family.margin(a, sigma) <= 0.0) != stable_after and (family.margin(b, sigma) <= 0.0) == stable_after:
+        return c
+    return float(brentq(lambda S: family.margin(S, sigma), left, right, xtol=tol, rtol=4 * np.finfo(float).eps))
 
 
 def _ends_agree(family: CountedFamily, intervals: list[StabilityInterval], lo: float, hi: float, sigma: float,
@@ -330,11 +325,7 @@ def least_damping_ratio(model: StabilityModel, speed_range: tuple[float, float],
     family = CountedFamily(model, track)
     lo, hi = speed_range
 
-    def zeta(S: float) -> float:
-        s = family.roots(float(S))
-        live = s[np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s))]
-        return float(np.min(-live.real / np.abs(live))) if live.size else math.inf
-
+    zeta = family.least_damping
     speeds = np.linspace(lo, hi, max(int(points), 2))
     values = np.array([zeta(S) for S in speeds])
     k = int(np.argmin(values))
