@@ -406,7 +406,8 @@ def plot_tradeoff(table: pd.DataFrame, quantity: str, title: str, required: floa
     ax.plot(front[quantity], front["U"], color="C3", ls="-", marker=".", lw=1.2, label="non-dominated")
     if required is not None:
         ax.axvline(required, color="k", ls="--", lw=0.9, label=f"requirement {required:.4g}")
-    unit = " (m/s)" if quantity.endswith("_m_s") else " (m)" if "stroke" in quantity else ""
+    unit = " (m/s)" if quantity.endswith("_m_s") else " (m)" if "stroke" in quantity else \
+        " (−Re s/|s|, dimensionless)" if "damping_ratio" in quantity else ""
     ax.set_xlabel(f"{quantity}{unit}")
     ax.set_ylabel("U: certified peak of the objective output")
     ax.set_title(title, fontsize=9, wrap=True)
