@@ -8,65 +8,39 @@ warnings (things a study does not refuse but a user must hear of) ``railopt: war
 ``railopt run studies/<name>.toml [--workers N] [--scheduler ADDR] [--resume]`` validates the
 config (errors name the field, exit code 2, nothing written), takes the study's lock, runs the
 study into a staging folder, and swaps it in as ``results/<name>/`` only when the run succeeds
-(see :mod:`railopt.studies.output.publish`).  Every failure a user can cause — a bad config, a damaged
-store, a results folder that cannot be written, a busy study, an unreachable scheduler — ends as
-one line on stderr naming the file, field or address, and exit code 2.
+(see :mod:`railopt.studies.output.publish`; the run itself is
+:func:`railopt.studies.run_study.execute_study`, shared with the Python API ``run_study``).  Every failure a user
+can cause — a bad config, a damaged store, a results folder that cannot be written, a busy study, an unreachable
+scheduler — ends as one line on stderr naming the file, field or address, and exit code 2.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import shutil
 import signal
 import sqlite3
 import sys
 import threading
-import time
 from collections.abc import Sequence
 from pathlib import Path
 
 from railopt import __version__
 from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV, scheduler_timeout
 from railopt.studies.config import ConfigError, load_study, read_toml
-from railopt.studies.kind import StudyContext, StudyKind
+from railopt.studies.kind import StudyKind
 from railopt.studies.output.markdown import markdown_table
-from railopt.studies.output.publish import (
-    CAMPAIGNS,
-    ResultsError,
-    carry_stores,
-    check_writable,
-    clear_leftovers,
-    ensure_folder,
-    publish,
-    staging_path,
-    study_lock,
-    writing,
-)
-from railopt.studies.output.writer import Writer
+from railopt.studies.output.publish import ResultsError
+from railopt.studies.run_study import STUDIES_DIR, execute_study, resolve_study, run_timing
 
 __all__ = [
     "STUDIES_DIR", "build_parser", "cmd_bench", "cmd_list", "cmd_reference", "cmd_run", "cmd_validate",
     "cmd_vehicle", "main", "main_vehicle", "print_warnings", "resolve_study", "run_timing",
 ]
 
-STUDIES_DIR = Path(__file__).resolve().parent
 EXIT_USAGE = 2
 EXIT_FAILED = 1
 EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143
-
-
-def resolve_study(arg: str) -> Path:
-    """A path as given, else ``<name>.toml`` among the bundled studies."""
-    path = Path(arg)
-    if path.is_file():
-        return path
-    for candidate in (STUDIES_DIR / arg, STUDIES_DIR / f"{arg}.toml"):
-        if candidate.is_file():
-            return candidate
-    raise ConfigError(f"{arg}: study: no such file (and no bundled study of that name; see `railopt list`)")
 
 
 def print_warnings(kind: StudyKind, config: object, study_file: Path | str) -> list[str]:
@@ -94,61 +68,21 @@ def _terminate(signum: int, frame: object) -> None:
     raise _Terminated
 
 
-def run_timing(compute_s: float, report_s: float, context: StudyContext):
-    """One row: how long the run's compute and report took (s), whether it resumed stored work, and where it ran
-    (``timing.csv`` of every study)."""
-    import pandas as pd
-
-    where = "; ".join(context.executed_on) or "serial"  # what the run really used (kinds without dask: serial)
-    return pd.DataFrame([{"compute_s": compute_s, "report_s": report_s, "total_s": compute_s + report_s,
-                          "resumed": bool(context.resume), "cpus": os.cpu_count(), "workers": where,
-                          "machine": platform.machine(), "python": platform.python_version()}])
-
-
 def cmd_run(args: argparse.Namespace) -> int:
     """``railopt run``: validate, compute and publish one study; exit code 2 on a user error."""
     study_file = resolve_study(args.study)
     kind, config, _ = load_study(study_file)
     _check_flags(args)
     print_warnings(kind, config, study_file)
-    name = config.study.name
-    results = ensure_folder(Path(args.results))
-    final = results / name
-    if final.exists() and not final.is_dir():
-        raise ResultsError(f"results: {final} is a file, not a folder; move it away to publish study {name!r}")
-    check_writable(results, final, final / CAMPAIGNS)  # before hours of work, not when publishing
-    with study_lock(results, name):
-        clear_leftovers(results, name)
-        staging = ensure_folder(staging_path(results, name))
-        context = StudyContext(
-            store_dir=staging if args.fresh else final,  # --fresh: old stores go only when this run is published
-            workers=args.workers,
-            scheduler=args.scheduler,
-            scheduler_timeout=args.scheduler_timeout,
-            resume=args.resume,
-            retry_failed=args.retry_failed,
-            show_progress=not args.no_progress,
-        )
-        try:
-            started = time.perf_counter()
-            result = kind.compute(config, context)
-            computed = time.perf_counter()
-            writer = Writer(staging)
-            writer.text(kind.report(result, writer), "summary.md")
-            writer.copy(study_file, "study.toml")
-            reported = time.perf_counter()
-            writer.table(run_timing(computed - started, reported - computed, context), "timing")
-            if not args.fresh:
-                carry_stores(final, staging)
-            with writing(final):
-                publish(staging, final)
-        finally:
-            shutil.rmtree(staging, ignore_errors=True)
-    with_pd_options = result.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")
+    done = execute_study(study_file, kind, config, Path(args.results), fresh=args.fresh, resume=args.resume,
+                         workers=args.workers, scheduler=args.scheduler, scheduler_timeout=args.scheduler_timeout,
+                         retry_failed=args.retry_failed, show_progress=not args.no_progress)
+    name, final = done.name, done.folder
+    with_pd_options = done.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")
     print(f"\n{name}: {kind.summary}\n")
     print(with_pd_options)
-    print(f"\ncompute {computed - started:.1f} s, report {reported - computed:.1f} s")
-    print(f"\nwritten to {final}/ ({', '.join(['summary.md', *writer.files])})")
+    print(f"\ncompute {done.compute_s:.1f} s, report {done.report_s:.1f} s")
+    print(f"\nwritten to {final}/ ({', '.join(['summary.md', *done.files])})")
     return 0
 
 
