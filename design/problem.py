@@ -7,6 +7,7 @@ imports the model layer: ``functions`` is any callable.
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -15,6 +16,12 @@ import numpy as np
 from railopt.design.variables import DesignVariable, Space
 
 VectorFunction = Callable[[np.ndarray], np.ndarray]
+
+
+class ProblemDefinitionError(ValueError):
+    """The problem's definition is inconsistent (e.g. ``epsilon`` of a length other than the number of constraints
+    found at the first evaluation): not a failure of the model at one x, so :func:`~railopt.design.solve.solve`
+    raises it instead of reporting a status."""
 
 
 @dataclass(frozen=True)
@@ -49,7 +56,9 @@ class MinimaxProblem:
     constraints, constraint_jacobian : callable, optional
         ``g(x) -> (p,)`` and its Jacobian (same conventions as above).
     epsilon : float or (p,) array
-        Right-hand side of g(x) ≤ ε.
+        Right-hand side of g(x) ≤ ε: a scalar applies to every constraint (whatever their number); an array
+        needs one value per constraint.  A wrong length is a ``ValueError`` naming ``epsilon``: here when the count
+        is known (``n_constraints``), otherwise at the first evaluation (when ``constraints`` first returns).
     fd_step : float
         Relative finite-difference step (of each variable's range).
     refine : callable, optional
@@ -57,6 +66,17 @@ class MinimaxProblem:
         certifies a solved design against the continuum the rows sample (e.g. every speed of a range) and returns
         the problem with rows added where it is violated, or None when ``x`` is certified.  :func:`solve` then
         resumes from ``x`` on the refined problem, up to ``MAX_EXCHANGES`` rounds.
+    n_constraints : int, optional
+        The number p of values ``constraints`` returns, when known in advance: ``epsilon`` is checked against it
+        here, and every evaluation must return p values (a ``ValueError`` naming ``constraints`` otherwise).
+        Without it p is learnt from the first evaluation.
+
+    Raises
+    ------
+    ValueError
+        Naming the field: a non-callable ``functions``, ``jacobian``, ``constraints`` or ``refine``; ``epsilon`` not
+        finite, not a scalar or 1-D, of a length other than ``n_constraints``, or an array without constraints;
+        ``n_constraints`` not a positive integer, or given without constraints.
     """
 
     def __init__(
@@ -69,6 +89,7 @@ class MinimaxProblem:
         epsilon: float | Sequence[float] = 0.0,
         fd_step: float = 1e-6,
         refine: Callable[[np.ndarray], MinimaxProblem | None] | None = None,
+        n_constraints: int | None = None,
     ) -> None:
         self.space = Space(variables)
         if refine is not None and not callable(refine):
@@ -84,23 +105,58 @@ class MinimaxProblem:
         self._jacobian = jacobian
         self._constraints = constraints
         self._constraint_jacobian = constraint_jacobian
-        self.epsilon = np.atleast_1d(np.asarray(epsilon, dtype=float))
-        if not np.all(np.isfinite(self.epsilon)):
+        try:
+            eps = np.asarray(epsilon, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"epsilon: must be a number or a 1-D array of numbers, got {epsilon!r}") from exc
+        if eps.ndim > 1 or eps.size == 0:
+            raise ValueError(f"epsilon: must be a number or a non-empty 1-D array (one value per constraint), got "
+                             f"shape {eps.shape}")
+        if not np.all(np.isfinite(eps)):
             raise ValueError("epsilon: must be finite")
+        if n_constraints is not None:
+            if constraints is None:
+                raise ValueError("n_constraints: given, but the problem has no constraints")
+            if isinstance(n_constraints, bool) or not isinstance(n_constraints, numbers.Integral) or n_constraints < 1:
+                raise ValueError(f"n_constraints: must be a positive integer, got {n_constraints!r}")
+            n_constraints = int(n_constraints)
+        if constraints is None and eps.size > 1:
+            raise ValueError(f"epsilon: {eps.size} values, but the problem has no constraints")
+        self._epsilon = np.atleast_1d(eps)
+        self.n_constraints: int | None = None
+        if n_constraints is not None:
+            self._learn_constraint_count(n_constraints, "n_constraints")
         self.fd_step = float(fd_step)
         self.n_functions: int | None = None
 
+    @property
+    def epsilon(self) -> np.ndarray:
+        """ε of g(x) ≤ ε, one value per constraint (shape (p,)) once p is known (``n_constraints`` or the first
+        evaluation); before that, the values as given (a scalar as shape (1,))."""
+        if self.n_constraints is not None and self._epsilon.size == 1:
+            return np.full(self.n_constraints, self._epsilon[0])
+        return self._epsilon.copy()
+
+    def _learn_constraint_count(self, p: int, source: str) -> None:
+        """Fix the number of constraints p (from ``n_constraints`` or the first evaluation) and check ε against it."""
+        if self._epsilon.size not in (1, p):
+            where = "n_constraints" if source == "n_constraints" else "values the constraints returned"
+            raise ProblemDefinitionError(
+                f"epsilon: has {self._epsilon.size} values, but there are {p} constraints ({where}: {p}); give one "
+                "value per constraint, or a scalar for all")
+        self.n_constraints = p
+
     def with_epsilon(self, epsilon: float | Sequence[float]) -> MinimaxProblem:
         """The same problem with another right-hand side ε of g(x) ≤ ε (ε-constraint sweeps)."""
-        return self.with_constraints(self._constraints, self._constraint_jacobian, epsilon)
+        return self.with_constraints(self._constraints, self._constraint_jacobian, epsilon, self.n_constraints)
 
     def with_constraints(self, constraints: VectorFunction | None,
                          constraint_jacobian: VectorFunction | bool | None = None,
-                         epsilon: float | Sequence[float] = 0.0) -> MinimaxProblem:
+                         epsilon: float | Sequence[float] = 0.0, n_constraints: int | None = None) -> MinimaxProblem:
         """The same objective subject to other constraints g(x) ≤ ε (conventions as in the constructor); the
         exchange (``refine``) belongs to the constraints it refined and is not carried over."""
         return MinimaxProblem(self.variables, self._functions, self._jacobian, constraints, constraint_jacobian,
-                              epsilon, self.fd_step)
+                              epsilon, self.fd_step, n_constraints=n_constraints)
 
     @property
     def variables(self) -> tuple[DesignVariable, ...]:
@@ -170,6 +226,12 @@ class MinimaxProblem:
             raise ValueError(
                 f"functions: returned {len(f)} values, earlier {self.n_functions}; the count must be fixed"
             )
+        if self.has_constraints:
+            if self.n_constraints is None:
+                self._learn_constraint_count(len(g), "evaluation")
+            elif len(g) != self.n_constraints:
+                raise ValueError(f"constraints: returned {len(g)} values, expected {self.n_constraints}; the count "
+                                 "must be fixed")
         return Evaluation(f, g, df, dg, f_replaced + g_replaced)
 
     def value(self, x: Sequence[float]) -> float:
@@ -181,8 +243,12 @@ class MinimaxProblem:
         ev = evaluation if evaluation is not None else self.evaluate(x)
         if ev.g.size == 0:
             return 0.0
-        excess = ev.g - np.broadcast_to(self.epsilon, ev.g.shape)
+        excess = ev.g - self._rhs(ev.g)
         return float(max(0.0, np.max(np.where(np.isfinite(excess), excess, np.inf))))
+
+    def _rhs(self, g: np.ndarray) -> np.ndarray:
+        """ε broadcast to the shape of ``g`` (the count was checked when it was learnt)."""
+        return np.broadcast_to(self._epsilon, g.shape)
 
     # ------------------------------------------------------------------ derivatives
     def _fd(self, fun: VectorFunction, x: np.ndarray, field: str = "functions", m: int | None = None,
@@ -245,4 +311,4 @@ class MinimaxProblem:
         return J
 
 
-__all__ = ["Evaluation", "MinimaxProblem", "VectorFunction"]
+__all__ = ["Evaluation", "MinimaxProblem", "ProblemDefinitionError", "VectorFunction"]

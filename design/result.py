@@ -90,6 +90,22 @@ class SolveResult(ArrayRecord):
             raise ValueError(f"status: unknown status {self.status!r}")
         super().__post_init__()
 
+    def __repr__(self) -> str:
+        """Every field in full, one per line (like scipy's ``OptimizeResult``): ``x``, ``value`` (U), ``status``,
+        ``success`` and the whole ``message`` first (strings unquoted); arrays with the shortest digits that
+        round-trip."""
+        def text(value: Any) -> str:
+            if isinstance(value, np.ndarray):
+                return np.array2string(value, separator=", ", floatmode="unique", max_line_width=100,
+                                       threshold=10_000).replace("\n", "\n" + " " * 23)
+            return value if isinstance(value, str) else repr(value)
+
+        rows = [("x", self.x), ("value", self.value), ("status", self.status), ("success", self.success),
+                ("message", self.message), ("method", self.method), ("evaluations", self.evaluations),
+                ("wall_time", self.wall_time), ("t", self.t), ("constraint_violation", self.constraint_violation),
+                ("bound_violation", self.bound_violation), ("x0", self.x0), ("functions", self.functions)]
+        return "SolveResult(\n" + "".join(f"{name:>20s}: {text(value)}\n" for name, value in rows) + ")"
+
     def to_dict(self) -> dict[str, Any]:
         """Every field, arrays as lists of floats (JSON-ready)."""
         return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
@@ -102,7 +118,7 @@ class SolveResult(ArrayRecord):
     @property
     def success(self) -> bool:
         """:func:`succeeded` of this result."""
-        return succeeded(self.status, self.constraint_violation, self.bound_violation, self.value)
+        return bool(succeeded(self.status, self.constraint_violation, self.bound_violation, self.value))
 
 
 __all__ = ["FEASIBILITY_TOL", "STATUSES", "SUCCESS_STATUSES", "SolveResult", "succeeded"]

@@ -76,6 +76,24 @@ def test_surface_and_solve_result_round_trip():
         r.x[0] = 2.0
 
 
+def test_solve_result_repr_shows_x_value_status_and_the_whole_message():
+    """Like scipy's OptimizeResult: every field in full; the numbers in the repr round-trip to the result's own."""
+    p = MinimaxProblem([DesignVariable("a", -1, 1), DesignVariable("b", -1, 1)],
+                       lambda x: np.array([x[0] ** 2 + x[1] ** 2 + 1.0, (x[0] - 0.5) ** 2 + 1.0]))
+    r = solve(p, [0.9, 0.9])
+    long_message = "NLopt failure: " + " ".join(f"step {i} rejected" for i in range(40))  # > 500 characters
+    r = dataclasses.replace(r, message=long_message)
+    text = repr(r)
+    fields = {line.split(":", 1)[0].strip(): line.split(":", 1)[1].strip()
+              for line in text.splitlines()[1:-1] if ":" in line}
+    assert fields["message"] == long_message
+    assert fields["status"] == r.status and fields["success"] == str(r.success)
+    assert float(fields["value"]) == r.value
+    np.testing.assert_array_equal(np.array(eval(fields["x"])), r.x)  # the shortest digits that round-trip
+    np.testing.assert_array_equal(np.array(eval(fields["functions"])), r.functions)
+    assert max(r.functions) == r.value  # U = max_k f_k, as printed
+
+
 @pytest.mark.slow
 def test_non_editable_install_imports_from_the_repository_root(tmp_path):
     """`pip install .` (not editable), then Python started in the repository root: the local railopt/ folder

@@ -14,7 +14,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from railopt.design.problem import Evaluation, MinimaxProblem
+from railopt.design.problem import Evaluation, MinimaxProblem, ProblemDefinitionError
 
 BIG = 1e12  # stands in for +inf inside solvers (U = inf is reported as inf)
 
@@ -59,6 +59,8 @@ class EpigraphView:
             raise StopSolve("maxtime", f"maxtime={self.options['maxtime']} s reached")
         try:
             ev = self.problem.evaluate(x, gradient=gradient)
+        except ProblemDefinitionError:  # the problem, not the model at x: the caller's error, raised
+            raise
         except Exception as exc:  # the user's model failed: keep the best point, report it
             raise StopSolve("error", f"{type(exc).__name__}: {exc}") from exc
         self.evaluations += 1
@@ -79,7 +81,7 @@ class EpigraphView:
         x = self.space.to_x(u)
         ev = self._raw(x, gradient)
         f = ev.f / self.scale
-        g = (ev.g - np.broadcast_to(self.problem.epsilon, ev.g.shape)) / self.scale
+        g = (ev.g - self.problem.epsilon) / self.scale  # ε has one value per constraint once they have been counted
         df = dg = None
         if gradient:
             chain = self.space.dx_du(u)

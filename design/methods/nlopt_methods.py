@@ -62,7 +62,7 @@ class NloptMethod:
             return float(z[-1])
 
         m = view.problem.n_functions
-        p = len(view.problem.epsilon) if view.problem.has_constraints else 0
+        p = view.problem.n_constraints or 0  # counted at the view's first evaluation
 
         def constraints(result: np.ndarray, z: np.ndarray, grad: np.ndarray) -> None:
             want = grad.size > 0

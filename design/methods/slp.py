@@ -48,7 +48,7 @@ class SLPMethod:
 
         d = view.space.dim
         m = view.problem.n_functions
-        p = len(view.problem.epsilon) if view.problem.has_constraints else 0
+        p = view.problem.n_constraints or 0  # counted at the view's first evaluation
         penalty = float(options["penalty"])
         fp, Jp = cp.Parameter(m), cp.Parameter((m, d))
         up, radius = cp.Parameter(d), cp.Parameter(nonneg=True)
