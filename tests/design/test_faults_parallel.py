@@ -17,8 +17,11 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import dask
+import distributed  # noqa: F401  (its config holds the connect timeout)
 import numpy as np
 import pytest
+from dask.utils import parse_timedelta
 
 from railopt.design import (
     CampaignStore,
@@ -32,6 +35,11 @@ from railopt.design import (
 from railopt.design.parallel import SCHEDULER_MARGIN, SchedulerError, dask_client, map_unordered
 
 U_STAR = 0.7 - np.sqrt(0.35)
+# A hang guard, not a timing of railopt (timings are `railopt bench` rows): what a client without our timeouts waits
+# for a silent or lost scheduler, dask's own connect timeout (30 s).  Our failures come after the test's timeout
+# (2-3 s) plus SCHEDULER_MARGIN; the guard only tells "gave up on our timeout" from "waited for dask's".
+HANG_S = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"))
+assert HANG_S > 3 + SCHEDULER_MARGIN  # the guard separates the two
 VARIABLES = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0)]
 
 
@@ -253,7 +261,8 @@ def test_a_server_that_is_not_a_scheduler_fails_within_the_timeout(reply: bytes 
         pass
     elapsed = time.monotonic() - began
     assert address in str(err.value) and "--workers N" in str(err.value)
-    assert elapsed < 2 + SCHEDULER_MARGIN + 2, elapsed
+    assert elapsed >= 2 or reply is not None, elapsed  # a silent server is given the whole timeout
+    assert elapsed < HANG_S, elapsed
     srv.close()
     for c in held:
         c.close()
@@ -305,8 +314,9 @@ def test_a_scheduler_without_workers_is_named_within_the_timeout(scheduler) -> N
     began = time.monotonic()
     with pytest.raises(SchedulerError, match="has no workers") as err, dask_client(scheduler=address, timeout=2):
         pass
-    assert address in str(err.value)
-    assert time.monotonic() - began < 2 + SCHEDULER_MARGIN + 2
+    elapsed = time.monotonic() - began
+    assert address in str(err.value) and "waited 2 s" in str(err.value)
+    assert 2 <= elapsed < HANG_S, elapsed  # it waited the timeout for a worker to join, then gave up
 
 
 @dataclass(frozen=True)
@@ -341,7 +351,7 @@ def test_a_lost_scheduler_is_one_error_and_the_finished_starts_are_kept(schedule
         _stop(worker)
     assert str(err.value) == (f"scheduler: lost the connection to {address!r}; finished starts are kept, "
                               "rerun with --resume")
-    assert waited < 3 + SCHEDULER_MARGIN + 5, waited
+    assert waited < HANG_S, waited
     assert 2 <= len(kept) < 12
     # the resume (serial) completes every start exactly once and keeps the finished ones as they were
     with CampaignStore.open(path) as store:

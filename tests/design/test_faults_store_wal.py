@@ -12,7 +12,6 @@ import sqlite3
 import subprocess
 import sys
 import textwrap
-import time
 from contextlib import closing
 from pathlib import Path
 
@@ -52,9 +51,7 @@ def test_a_reader_holding_a_transaction_does_not_block_the_campaign(tmp_path: Pa
     multistart(PROBLEM, 3, seed=1, store=store)
     reader = _reader(path, 60)
     try:
-        began = time.monotonic()
         table = multistart(PROBLEM, 12, seed=1, store=store)
-        elapsed = time.monotonic() - began
         assert reader.poll() is None  # the reader still holds its transaction: the writer did not wait for it
         # the reader's process sees the committed starts too (its own new transaction)
         with closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as db:
@@ -65,7 +62,7 @@ def test_a_reader_holding_a_transaction_does_not_block_the_campaign(tmp_path: Pa
     store.close()
     assert list(table["start_id"]) == list(range(12))  # the same seed: the 3 stored starts are ids 0-2 of the 12
     assert table["value"].min() == pytest.approx(U_STAR, abs=1e-7)
-    assert elapsed < 30, elapsed  # the old store failed after the 5 s default timeout ("database is locked")
+    # (the old store failed after sqlite's 5 s busy timeout, "database is locked": the table above is complete)
     assert _journal_mode(path) == "delete"  # closed: one self-contained file again
     assert sorted(p.name for p in tmp_path.iterdir()) == ["monitored.sqlite"]
 

@@ -61,8 +61,9 @@ def test_lightly_damped_sdof_peak_closed_form():
     sys = LinearSystem([[m]], [[c]], [[k]], [1.0], [k])
     rm = sys.response_maxima(band_rad_s=(0.0, 20.0), exact=True)
     assert rm.value == pytest.approx(1 / (2 * zeta * np.sqrt(1 - zeta**2)), rel=1e-10)
-    # a flat maximum locates only to ~sqrt(machine eps) relative (Brent's own tolerance)
-    assert rm.argmax_frequency == pytest.approx(10 * np.sqrt(1 - 2 * zeta**2), rel=3e-8)
+    # a flat maximum located on values: to Brent's bound 2·sqrt(ε)|Ω| ≈ 3e-8 relative at best, so 1e-7 (its scale,
+    # the half-power width 2ζΩ = 0.04 rad/s, is 4e4 times the 1e-6 rad/s allowed); the value is the well-determined one
+    assert rm.argmax_frequency == pytest.approx(10 * np.sqrt(1 - 2 * zeta**2), rel=1e-7)
     # thesis method: value at ω_d = ωn sqrt(1−ζ²), closed form 1/(ζ sqrt(4 − 3ζ²))
     thesis = sys.response_maxima(band_rad_s=(0.0, 20.0)).value
     assert thesis == pytest.approx(1 / (zeta * np.sqrt(4 - 3 * zeta**2)), rel=1e-10)

@@ -4,12 +4,18 @@ from __future__ import annotations
 
 import time
 
+import dask
+import distributed  # noqa: F401  (its config holds the connect timeout)
 import pytest
+from dask.utils import parse_timedelta
 from faults_cli import STUDY, assert_refused, cli, env, run_args, start_rows, store_path, study_file
 
 from railopt.studies.cli import main
 
 DEAD = "tcp://127.0.0.1:1"  # nothing listens on port 1
+# A hang guard, not a timing (timings are `railopt bench` rows): what a run without our timeout waited, dask's own
+# connect timeout; a refusal on our timeout (1-5 s) plus a CLI start is told from it however loaded the machine.
+HANG_S = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"))
 
 
 @pytest.fixture
@@ -28,8 +34,8 @@ def test_an_unreachable_scheduler_fails_fast_naming_the_address(how, study, tmp_
     began = time.monotonic()
     done = cli(*args, environ=environ)
     elapsed = time.monotonic() - began
-    assert_refused(done, f"cannot connect to '{DEAD}' within 1 s", "--workers N")
-    assert elapsed < 15, elapsed  # the run waited 33 s, then printed 66 lines of traceback
+    assert_refused(done, f"cannot connect to '{DEAD}' within 1 s", "--workers N")  # our timeout was the one used
+    assert elapsed < HANG_S, elapsed  # a hang guard: the run waited dask's own 30 s, then printed a traceback
     assert list(results.iterdir()) == []  # nothing published, no staging, lock released
 
 
@@ -39,7 +45,7 @@ def test_the_default_scheduler_timeout_is_a_few_seconds(study, tmp_path):
     done = cli(*run_args(study, tmp_path / "results", "--scheduler", DEAD, workers=None))
     elapsed = time.monotonic() - began
     assert_refused(done, DEAD, "within 5 s")
-    assert 5 <= elapsed < 20, elapsed
+    assert 5 <= elapsed < HANG_S, elapsed  # it waited the default 5 s (well-determined), not dask's 30 s
 
 
 def test_explicit_workers_0_beats_RAILOPT_SCHEDULER(study, tmp_path):

@@ -59,9 +59,15 @@ def test_closed_form_satisfies_the_ode_and_jump_conditions(zeta, theta, nu):
 def test_undamped_profile_is_symmetric_and_damped_maximum_lags():
     xi = np.linspace(-5, 5, 201)
     v = 0.5 * _beam(0, 0).critical_velocity()
-    und = moving_load(_beam(0.0, 0.0), xi, P, v)
+    b = _beam(0.0, 0.0)
+    und = moving_load(b, xi, P, v)
     assert np.allclose(und.y, und.y[::-1], rtol=0, atol=1e-12 * und.y_max)
-    assert abs(und.x_max) < 1e-9
+    # the value at the maximum is well-determined: (A.2.14) y(0) = P/(8 EI β² g), g = sqrt(β² − m v²/(4 EI))
+    assert und.y_max == pytest.approx(P / (8 * b.EI * b.beta**2 * np.sqrt(b.beta**2 - b.m * v * v / (4 * b.EI))),
+                                      rel=1e-12)
+    # its location is the root of y' (slope y'' ≠ 0 there), so it is determined to ~ε of the length scale 1/β;
+    # a search on values alone would place this flat maximum only to ~sqrt(ε)/β ≈ 1.6e-8 m
+    assert abs(und.x_max) < 1e-9 / b.beta
     lags = [moving_load(_beam(z, 0.0), xi, P, v).x_max for z in (0.05, 0.1, 0.2, 0.4)]
     assert all(lag < 0 for lag in lags)  # behind the load
     assert all(b < a for a, b in zip(lags, lags[1:], strict=False))  # growing with damping
