@@ -32,14 +32,14 @@ from scipy.optimize import brentq, minimize_scalar
 from railopt.models.crossings import declares_creep
 from railopt.models.modal import NEUTRAL_ROOT, mode_order
 from railopt.models.mode_names import (
-    HUNTING_COUPLING,
+    HUNTING_CIRCULATION,
     HUNTING_DAMPING,
-    HUNTING_LATERAL,
     MOTIONS,
     SIDES,
     WORDS,
     _named_roots,
     mode_name,
+    named_modes,
     readable,
 )
 from railopt.models.protocols import LateralModel, SpeedFamily, StabilityModel
@@ -72,7 +72,7 @@ __all__ = [
     # re-exported: the model types (railopt.models.protocols)
     "LateralModel", "SpeedFamily", "StabilityModel",
     # re-exported: the mode-naming vocabulary (railopt.models.mode_names)
-    "HUNTING_COUPLING", "HUNTING_DAMPING", "HUNTING_LATERAL", "MOTIONS", "SIDES", "WORDS", "mode_name", "readable",
+    "HUNTING_CIRCULATION", "HUNTING_DAMPING", "MOTIONS", "SIDES", "WORDS", "mode_name", "named_modes", "readable",
     # re-exported: the stability constraint rows (railopt.models.stability_rows)
     "StabilityRows", "damping_constraints", "root_constraints",
 ]

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from railopt.models.modal import NEUTRAL_ROOT, mode_order
-from railopt.models.mode_names import _body_dof, _shares, _track_body, mode_name
+from railopt.models.mode_names import _body_dof, _shares, _track_body, named_modes
 from railopt.models.sensitivity import damping_ratio_jacobian, eigenvalue_derivatives, root_jacobian
 from railopt.models.system import LinearSystem
 from railopt.models.validation import forward_speeds, number
@@ -32,8 +32,8 @@ def _family_rows(family: ParametricSystem, p: Sequence[float] | None, speeds: Se
     """Per speed: the member, its roots one per mode (mode order) and a mask of the kept (vehicle) modes.
 
     A mode is dropped when neutral, when lumped track bodies carry most of its energy (what
-    :func:`mode_name` calls "track") or, with ``exclude``, when its name, group or a prefix is listed; the
-    names are only worked out when something is excluded (the constraint rows need the mask alone)."""
+    :func:`~railopt.models.mode_names.named_modes` calls "track") or, with ``exclude``, when its name, group or
+    a prefix is listed; the names are only worked out when something is excluded (the rows need the mask alone)."""
     if isinstance(exclude, str):  # a bare string would be read letter by letter
         raise ValueError(f"exclude: a list of mode names, groups or prefixes, got the string {exclude!r}; "
                          f"write [{exclude!r}]")
@@ -48,8 +48,9 @@ def _family_rows(family: ParametricSystem, p: Sequence[float] | None, speeds: Se
         roots = m.s[idx]
         shares = _shares(system, m.V[:system.n, idx])
         keep = (np.abs(roots) > NEUTRAL_ROOT * float(np.max(np.abs(m.s)))) & (shares[track].sum(axis=0) <= 0.5)
+        named = named_modes(system, groups, main) if exclude else []
         for j in np.flatnonzero(keep) if exclude else ():
-            name, group, _ = mode_name(system.names, shares[:, j], -roots[j].real / abs(roots[j]), groups, main)
+            name, group = named[j].name, named[j].group
             if any(x == name or x == group or name.startswith(x) for x in exclude):
                 keep[j] = False
         yield float(S), system, idx, keep
