@@ -15,6 +15,11 @@ quadrature), a single function; its gradient is analytic on the final quadrature
 ``dRMS/dx = Σ_k w_k S_k Re(conj(H_k) dH_k/dx) / RMS`` with ``dH/dx = (iω)^q c·Z⁻¹(dF/dx − dZ/dx Z⁻¹F)`` from the
 member's tangent (the rule's nodes held fixed: the derivative of the discrete sum, equal to the derivative of
 the RMS to the quadrature tolerance).
+
+Where an objective does not exist at a design — an unstable member has no steady-state response and no stationary
+random response; an undamped mode inside the band makes the band maximum (and the RMS) unbounded — its value is
++inf, never an exception: a solver's line search backs off from it as from a barrier, and a start placed there ends
+with U = inf, which the campaign report counts with the reason :func:`objective_value` gives.
 """
 
 from __future__ import annotations
@@ -27,7 +32,8 @@ import numpy as np
 
 from railopt.design import DesignVariable, MinimaxProblem
 from railopt.models import LinearSystem
-from railopt.models.random_response import random_response
+from railopt.models.modal import growing_roots
+from railopt.models.random_response import RandomResponse, random_response
 from railopt.models.response_maxima import all_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
 from railopt.models.stability_map import least_damping_ratio, stability_map, worst_speed
@@ -45,6 +51,7 @@ __all__ = [
     "StabilityExchange",
     "StabilityTarget",
     "minimax_problem",
+    "objective_value",
     "response_target",
     "rms_gradient",
     "rms_target",
@@ -76,6 +83,68 @@ class RMSTarget:
     speed: float
     scale: float = 1.0
     rtol: float = 1e-8
+
+    def response(self, system: LinearSystem) -> RandomResponse | str:
+        """The random response of ``system`` (a member of the family, forced per the model's amplitude) or, where
+        none exists, why (a non-empty reason): a growing root (no stationary response), an undamped mode in the
+        band (|H| unbounded there).  Other failures of the quadrature raise as
+        :func:`~railopt.models.random_response.random_response` does."""
+        reason = _no_steady_state(system)
+        if reason:
+            return reason + "; a stationary random response does not exist"
+        try:
+            return random_response(system, self.spectrum, self.speed, self.band_hz, self.output, self.rtol)
+        except ValueError:
+            undamped = _undamped_in_band(system, (self.band_hz[0] * RAD_PER_HZ, self.band_hz[1] * RAD_PER_HZ))
+            if undamped:
+                return undamped + "; the RMS is unbounded"
+            raise
+
+
+def _no_steady_state(system: LinearSystem) -> str:
+    """Why ``system`` has no steady-state response ("" when it has one): its fastest-growing root."""
+    growing = growing_roots(system.eigenvalues())
+    if not growing.size:
+        return ""
+    worst = growing[np.argmax(growing.real)]
+    return (f"unstable: root s = {worst.real:.4g}{worst.imag:+.4g}i 1/s ({abs(worst.imag) / RAD_PER_HZ:.4g} Hz) "
+            "has Re s > 0")
+
+
+def _undamped_in_band(system: LinearSystem, band_rad_s: tuple[float, float]) -> str:
+    """An undamped mode inside the band (rad/s), in words ("" when there is none)."""
+    freqs = system.damped_frequencies()[system.undamped_modes()]
+    inside = freqs[(freqs >= band_rad_s[0]) & (freqs <= band_rad_s[1])]
+    return f"an undamped mode at {inside[0] / RAD_PER_HZ:.4g} Hz inside the band" if inside.size else ""
+
+
+def objective_value(system: LinearSystem, target: ResponseTarget | RMSTarget) -> tuple[float, str]:
+    """The objective at one member of the family and, where it does not exist, why.
+
+    Parameters
+    ----------
+    system : LinearSystem
+        The family at the design's parameters (``ParametricSystem.at(p)``).
+    target : ResponseTarget or RMSTarget
+        The band maximum (certified with ``exact``) of an output, or its RMS per metre under a spectrum.
+
+    Returns
+    -------
+    (float, str)
+        The value (output units; per metre for an RMS) and ``""``; or ``inf`` and the reason: an unstable member
+        (its growing root: no steady state, no stationary random response) or an undamped mode inside the band
+        (an unbounded band maximum or RMS).  The value is the one the minimax problem's objective takes.
+    """
+    if isinstance(target, RMSTarget):
+        response = target.response(system)
+        return (float("inf"), response) if isinstance(response, str) else (target.scale * response.rms, "")
+    maxima = all_response_maxima(system, band_rad_s=target.band, exact=target.exact, outputs=[target.output])
+    value = maxima[target.output].value
+    if np.isfinite(value):
+        return float(value), ""
+    unstable = _no_steady_state(system)
+    reason = unstable + "; no steady-state response exists" if unstable else _undamped_in_band(system, target.band)
+    return float("inf"), f"{reason}; the band maximum is unbounded" if reason else "the band maximum is unbounded"
 
 
 def rms_gradient(system: LinearSystem, response, dp: np.ndarray) -> np.ndarray:
@@ -179,20 +248,23 @@ class _Evaluator:
         return np.vstack([maxima_jacobians(sys, band_rad_s=t.band, exact=t.exact, outputs=[t.output],
                                            maxima={t.output: self._maxima(x, t)})[t.output][1] @ dp for t in targets])
 
-    def _rms(self, x: np.ndarray, target: RMSTarget):
+    def _rms(self, x: np.ndarray, target: RMSTarget) -> RandomResponse | str:
         sys, _ = self.system(x)
-        return self._piece(x, "rms", target, lambda: random_response(
-            sys, target.spectrum, target.speed, target.band_hz, target.output, target.rtol))
+        return self._piece(x, "rms", target, lambda: target.response(sys))
 
     def objective(self, x: np.ndarray, target: ResponseTarget | RMSTarget) -> np.ndarray:
         if isinstance(target, RMSTarget):
-            return np.array([target.scale * self._rms(x, target).rms])
+            response = self._rms(x, target)  # a reason where none exists: +inf, a barrier to line searches
+            return np.array([np.inf if isinstance(response, str) else target.scale * response.rms])
         return self.maxima(x, [target])
 
     def objective_jacobian(self, x: np.ndarray, target: ResponseTarget | RMSTarget) -> np.ndarray:
         if isinstance(target, RMSTarget):
             sys, dp = self.system(x)
-            return target.scale * rms_gradient(sys, self._rms(x, target), dp)[None, :]
+            response = self._rms(x, target)
+            if isinstance(response, str):  # f = inf carries no slope (the design layer zeroes it too)
+                return np.zeros((1, dp.shape[1]))
+            return target.scale * rms_gradient(sys, response, dp)[None, :]
         return self.maxima_jacobian(x, [target])
 
     def _stability_rows(self, x: np.ndarray,

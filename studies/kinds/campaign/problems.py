@@ -1,6 +1,7 @@
 """Problems of the ``campaign`` kind: the minimax problem of one model × objective × problem (targets made by
-:mod:`railopt.studies.adapter` from the config's specs), the design's parameters, the certified peak at a design,
-the starts, and the problems and quantities of the trade-off sweeps and surfaces."""
+:mod:`railopt.studies.adapter` from the config's specs), the design's parameters, the certified peak and the
+measure of each objective at a design (:data:`MEASURES`), the starts, and the problems and quantities of the
+trade-off sweeps and surfaces."""
 
 from __future__ import annotations
 
@@ -9,11 +10,26 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from railopt.design import MinimaxProblem
-from railopt.studies.adapter import minimax_problem, response_target, rms_target, stability_target
+from railopt.studies.adapter import (
+    ResponseTarget,
+    RMSTarget,
+    minimax_problem,
+    objective_value,
+    response_target,
+    rms_target,
+    stability_target,
+)
 from railopt.studies.catalog import Check, ModelSetup
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig, ConstraintSpec, StabilitySpec, TradeoffSpec
 
-__all__ = ["FeasibleDesign", "campaign_label", "campaign_problem", "design_peak"]
+__all__ = ["MEASURES", "FeasibleDesign", "campaign_label", "campaign_problem", "design_peak", "design_value",
+           "measure_label", "measure_target", "reported_measures", "section_objective", "study_measures"]
+
+MEASURES: dict[str, str] = {"thesis": "peak", "exact": "peak", "rms": "rms"}
+"""What each objective kind minimises, as the measure a design is judged by: ``peak``, the certified band maximum
+of |H| under the sinusoid (the thesis objective is judged by the maximum it approximates), or ``rms``, the RMS per
+metre of irregularity under ``[objective.spectrum]``.  A campaign's headline, before/after and tables are in the
+measure of the objective it minimised; the other measure is a side column."""
 
 
 def campaign_label(model: str, objective: str, method: str, problem: str = "constrained") -> str:
@@ -50,6 +66,60 @@ def design_peak(cfg: CampaignStudyConfig, setup: ModelSetup, values: dict[str, f
     """Certified band maximum of the objective output at a design {variable: value}."""
     target = response_target(cfg.objective, setup, exact=True)
     return setup.family.at(_p(cfg, setup, values)).peak(band_rad_s=target.band, exact=True, output=target.output)
+
+
+def measure_target(cfg: CampaignStudyConfig, setup: ModelSetup, measure: str) -> ResponseTarget | RMSTarget:
+    """The adapter's target of a measure (a key's value of :data:`MEASURES`): the certified band maximum of the
+    objective output, or its RMS per metre under the spectrum."""
+    if measure == "rms":
+        return rms_target(cfg.objective, setup)
+    if measure == "peak":
+        return response_target(cfg.objective, setup, exact=True)
+    raise ValueError(f"measure: unknown measure {measure!r}; measures are {sorted(set(MEASURES.values()))}")
+
+
+def design_value(cfg: CampaignStudyConfig, setup: ModelSetup, measure: str, values: dict[str, float]
+                 ) -> tuple[float, str]:
+    """A design {variable: value} in ``measure`` (output units; an RMS per metre), and ``""`` — or ``inf`` and why
+    the measure does not exist there (an unstable design, an undamped mode in the band):
+    :func:`railopt.studies.adapter.objective_value`."""
+    return objective_value(setup.family.at(_p(cfg, setup, values)), measure_target(cfg, setup, measure))
+
+
+def measure_label(cfg: CampaignStudyConfig, setup: ModelSetup, measure: str) -> str:
+    """The measure in words, with its unit: ``"RMS of cab.lateral under erri_b176 low alignment at 25 m/s,
+    0.5–15 Hz (m/s²)"`` or ``"peak |cab_acceleration| over 0–3 Hz, certified (m/s² per 6.35 mm ... irregularity)"``."""
+    output = cfg.objective.output or setup.family.output_names[0]
+    band = f"{cfg.objective.band_hz[0]:g}–{cfg.objective.band_hz[1]:g} Hz"
+    unit = setup.units.get(output, "")
+    if measure == "rms":
+        sp = cfg.objective.spectrum
+        named = sp.path if sp.standard == "table" else " ".join(
+            str(v) for v in (sp.standard, f"class {sp.track_class}" if sp.track_class else sp.level, sp.component) if v)
+        return f"RMS of {output} under {named} at {setup.family.speed:g} m/s, {band}" + (f" ({unit})" if unit else "")
+    per = " ".join(p for p in (unit, f"per {setup.input_label}" if setup.input_label else "") if p)
+    return f"peak |{output}| over {band}, certified" + (f" ({per})" if per else "")
+
+
+def study_measures(cfg: CampaignStudyConfig, problem: str | None = None) -> list[str]:
+    """The measures (:data:`MEASURES`) of ``problem``'s objectives (of every problem's when None), in the order the
+    objectives are first listed: the first of the recommended problem's is the study's headline measure."""
+    problems = cfg.design.problems if problem is None else [problem]
+    return list(dict.fromkeys(MEASURES[o] for prob in problems for o, _ in cfg.design.plan(prob)))
+
+
+def reported_measures(cfg: CampaignStudyConfig) -> list[str]:
+    """The measures a design is reported in: the study's (:func:`study_measures`) and always the certified peak (a
+    side column of an ``rms`` study; the RMS needs the spectrum and speed only an ``rms`` study has)."""
+    return list(dict.fromkeys([*study_measures(cfg), "peak"]))
+
+
+def section_objective(cfg: CampaignStudyConfig, measure: str | None = None) -> str:
+    """The objective kind whose problem the model sections (before/after, trade-offs, surfaces) solve: of
+    ``measure``'s objectives (all of them when None) ``exact`` if the study has it, else the first of the study's."""
+    planned = [o for o in dict.fromkeys([*cfg.design.objectives, *(cfg.design.constrained_objectives or [])])
+               if measure is None or MEASURES[o] == measure]
+    return "exact" if "exact" in planned else planned[0]
 
 
 def _starts(cfg: CampaignStudyConfig, setup: ModelSetup) -> list[list[float]] | None:

@@ -1,8 +1,12 @@
 """Report of the ``campaign`` kind: tables, figures and the summary, as a list of section builders.
 
 Each builder takes the :class:`~railopt.studies.kinds.campaign.run.CampaignResult` (or one model's sections)
-and the writer, writes its tables and figures, and returns its markdown lines: the comparison (every
-campaign), then per model the before/after (Figs 4.13–4.17), the trade-offs and the surfaces (Fig 4.18).
+and the writer, writes its tables and figures, and returns its markdown lines: the recommended design, the
+comparison (every campaign) and every start's outcome, then per model the before/after (Figs 4.13–4.17), the
+trade-offs and the surfaces (Fig 4.18).  Headlines, before/after and U columns are in the measure the objective
+minimised (the certified peak, or the RMS under the spectrum; the other measure is a named side column); every
+table where a vehicle is involved names it (``vehicle``, ``vehicle_file``); an infinite critical speed prints as
+"stable over the range (… m/s)" (the range searched; CSVs keep ``inf`` with ``critical_speed_search_m_s``).
 """
 
 from __future__ import annotations
@@ -10,8 +14,17 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from railopt.studies.kinds.campaign.problems import MEASURES, measure_label
 from railopt.studies.kinds.campaign.run import CampaignResult
-from railopt.studies.kinds.campaign.sections import BeforeAfter, ModelSections
+from railopt.studies.kinds.campaign.sections import (
+    OUTCOMES,
+    BeforeAfter,
+    ModelSections,
+    model_vehicles,
+    outcome_counts,
+    start_outcomes,
+)
+from railopt.studies.kinds.campaign.selection import Recommended, change
 from railopt.studies.kinds.campaign.tradeoffs import Tradeoff, TradeoffSurfaces
 from railopt.studies.output.figures import (
     plot_before_after,
@@ -20,7 +33,7 @@ from railopt.studies.output.figures import (
     plot_surfaces,
     plot_tradeoff,
 )
-from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.markdown import markdown_table, stable_over
 from railopt.studies.output.writer import Writer
 
 __all__ = [
@@ -29,27 +42,77 @@ __all__ = [
 ]
 
 
+# ---------------------------------------------------------------------------------------------- shared pieces
+def _search(result: CampaignResult, model: str) -> tuple[float, float] | None:
+    """The speed range (m/s) the model's hunting check searches for a critical speed (None without the check)."""
+    check = result.config.setups()[model].checks.get("hunting")
+    return None if check is None else tuple(check.search)
+
+
+def _speeds(result: CampaignResult, model: str, columns) -> dict[str, str]:
+    """Columns holding critical speeds -> the words their +inf prints as (:func:`stable_over` the range searched)."""
+    search = _search(result, model)
+    return {} if search is None else {str(c): stable_over(search) for c in columns
+                                      if str(c).startswith("critical")}
+
+
+def _csv(result: CampaignResult, df: pd.DataFrame, model: str | None = None) -> pd.DataFrame:
+    """``df`` as a CSV of the report: the vehicle of each row's model (or of ``model``) as ``vehicle`` and
+    ``vehicle_file`` after ``model``, and with critical speeds the range searched (``critical_speed_search_m_s``: an
+    ``inf`` there means stable over that range)."""
+    vehicles = model_vehicles(result.config)
+    models = [model] * len(df) if model is not None else (list(df["model"]) if "model" in df.columns else [])
+    out = df.copy()
+    if vehicles and models and any(m in vehicles for m in models):
+        at = list(out.columns).index("model") + 1 if "model" in out.columns else 0
+        for k, key in enumerate(("vehicle", "vehicle_file")):
+            out.insert(at + k, key, [vehicles.get(m, {}).get(key, "") for m in models])
+    if models and any(str(c).startswith("critical") for c in out.columns):
+        ranges = [_search(result, m) for m in models]
+        out["critical_speed_search_m_s"] = [f"{r[0]:g}-{r[1]:g}" if r else "" for r in ranges]
+    return out
+
+
+def _vehicle_line(result: CampaignResult, model: str) -> str:
+    """"Vehicle: **SD40-2**, file `sd40-2.toml (bundled)`." ("" for a model without a vehicle)."""
+    v = model_vehicles(result.config).get(model)
+    return f"Vehicle: **{v['vehicle']}**, file `{v['vehicle_file']}`." if v else ""
+
+
+def _signed(relative: float | None, worse: bool | None) -> str:
+    """A signed relative change in words: ``"-55.1 % (better)"``, ``"+67 % (WORSE)"``."""
+    if relative is None:
+        return "" if worse is None else "better (the existing value does not exist)"
+    return f"{100 * relative:+.3g} % ({'WORSE' if worse else 'better' if relative < 0 else 'unchanged'})"
+
+
 def _main_columns(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
-    cols = ["model", "problem", "objective", "method", *names, "U_objective", "true_peak", "objective_underestimate",
-            "active_bounds", "converged", "starts", "distinct_optima", "failing_optima", "best_failing_U",
-            "evaluations", "wall_time_s"]
+    cols = ["model", "vehicle", "problem", "objective", "method", *names, "U_objective", "true_peak", "true_rms",
+            "objective_underestimate", "active_bounds", "converged", "starts", "distinct_optima", "failing_optima",
+            "best_failing_U", "evaluations", "wall_time_s"]
     return comparison[[c for c in cols if c in comparison.columns]]
 
 
 def comparison_section(result: CampaignResult, writer: Writer) -> list[str]:
-    """comparison.csv, starts.csv/.parquet, optima.csv, frf.png and the summary's head."""
-    cfg, comparison = result.config, result.comparison
+    """comparison.csv, starts.csv/.parquet (with every start's ``outcome`` and ``reason``), outcomes.csv,
+    optima.csv, frf.png and the summary's head."""
+    cfg = result.config
+    comparison = _csv(result, result.comparison)
     names = [v.name for v in cfg.design.variables]
+    starts = start_outcomes(cfg, cfg.setups(), result.starts)
+    counts = _csv(result, outcome_counts(starts))
     writer.table(comparison, "comparison")
-    writer.table(result.starts, "starts", parquet=True)
-    writer.table(result.optima, "optima")
+    writer.table(_csv(result, starts), "starts", parquet=True)
+    writer.table(counts, "outcomes")
+    writer.table(_csv(result, result.optima), "optima")
     writer.figure(plot_frf_panels(result.frf_panels), "frf", dpi=cfg.report.dpi)
     d = cfg.design
-    starts = f"{d.n_starts} {d.sampler} starts (seed {d.seed})"
+    n_starts = f"{d.n_starts} {d.sampler} starts (seed {d.seed})"
     if d.start_from:
-        starts += " plus the named designs " + ", ".join(f"`{s}`" for s in d.start_from)
+        n_starts += " plus the named designs " + ", ".join(f"`{s}`" for s in d.start_from)
     if d.points:
-        starts += f" plus {len(d.points)} explicit point(s)"
+        n_starts += f" plus {len(d.points)} explicit point(s)"
+    vehicles = model_vehicles(cfg)
     lines = [
         f"# {cfg.study.name}",
         "",
@@ -57,11 +120,16 @@ def comparison_section(result: CampaignResult, writer: Writer) -> list[str]:
         "",
         f"Variables: {', '.join(f'{v.name} ∈ [{v.lower:g}, {v.upper:g}]' for v in d.variables)}; "
         f"objective: {cfg.objective.output or 'first output'} over {cfg.objective.band_hz[0]:g}–"
-        f"{cfg.objective.band_hz[1]:g} Hz; methods {', '.join(d.methods)}; {starts}.",
+        f"{cfg.objective.band_hz[1]:g} Hz; methods {', '.join(d.methods)}; {n_starts}."
+        + ("" if not vehicles else " Vehicles: " + "; ".join(
+            f"`{m}` is **{v['vehicle']}** (file `{v['vehicle_file']}`)" for m, v in vehicles.items()) + "."),
         "",
         "`thesis` minimises the response maxima (4.71)–(4.73) (|H| at the damped natural frequencies and the",
-        "band edges); `exact` minimises the certified band maximum. `true_peak` is the certified band maximum",
-        "at the best design found; `objective_underestimate` is how far the minimised value lies below it.",
+        "band edges); `exact` minimises the certified band maximum; `rms` minimises the RMS per metre of",
+        "irregularity under the track spectrum. `U_objective` is the campaign's own value at its best design (for",
+        "`rms` the RMS); `true_peak` is the certified band maximum there (for `rms` a side measure, not minimised)",
+        "and `true_rms` its RMS; `objective_underestimate` is how far the thesis or exact value lies below the",
+        "certified maximum (not applicable to `rms`).",
         "A campaign's best design is its best distinct optimum that passes every check (`design.checks`); the",
         "optima that fail them are counted in `failing_optima` and the best of them is `best_failing_U`",
         "(never reported as an optimum: `optima.csv` has each with its checks).",
@@ -70,11 +138,20 @@ def comparison_section(result: CampaignResult, writer: Writer) -> list[str]:
         "",
     ]
     for ref in cfg.report.compare:
-        cols = ["model", "problem", "objective", "method", f"{ref}_peak", f"change_vs_{ref}"]
+        cols = ["model", "problem", "objective", "method", f"{ref}_peak", f"{ref}_rms", f"change_vs_{ref}"]
         cols += [f"{n}_change_vs_{ref}" for n in names]
-        lines += [f"Against `{ref}` (its certified peak, and the best design's differences):", "",
+        lines += [f"Against `{ref}` (its certified peak and RMS, and the best design's signed change in the "
+                  f"campaign's own measure, negative: better; then the differences of the variables):", "",
                   markdown_table(comparison[[c for c in cols if c in comparison.columns]]), ""]
+    lost = counts[counts["outcome"] != "optimum"]
     lines += [
+        f"Every start by outcome (`outcomes.csv`; each start's `outcome` and `reason` are in `starts.csv`): "
+        f"{int(counts.loc[counts['outcome'] == 'optimum', 'starts'].sum())} of {len(starts)} converged to a "
+        f"feasible design; {int(lost['starts'].sum())} did not. "
+        + " ".join(f"`{k}`: {v}." for k, v in OUTCOMES.items() if k in set(counts["outcome"]) and k != "optimum"),
+        "",
+        markdown_table(counts),
+        "",
         "Per campaign: evaluations and wall time are sums over its starts; `comparison.csv` has every column.",
         "",
         "![FRF at the optima](frf.png)",
@@ -89,25 +166,43 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
     if ba is None:
         return []
     cfg, tag, model, best = result.config, s.tag, s.model, s.best
+    setup = cfg.setups()[model]
     dpi = cfg.report.dpi
-    writer.table(ba.table, f"before_after{tag}")
+    writer.table(_csv(result, ba.table, model), f"before_after{tag}")
+    worse = ba.table[ba.table["worse"].fillna(False).astype(bool)]
+    measure = ("the RMS per metre under the spectrum at the model's speed (the certified band maxima are the "
+               "`peak_…` side columns)" if s.measure == "rms" else "the certified band maximum")
     md = [f"## {model}: before (`{cfg.report.before}`) and after (best {best['objective']} optimum, "
-          f"{best['method']})", "", markdown_table(ba.table, digits=5), "",
-          f"Active bounds at the optimum: {', '.join(ba.active) if ba.active else 'none'}. The thesis approximation "
-          f"(4.71)–(4.73) reads {ba.thesis:.5g} at this optimum against the certified maximum {ba.exact:.5g} "
-          f"({100 * (ba.thesis - ba.exact) / ba.exact:+.2f} %).", ""]
+          f"{best['method']})", "", *([_vehicle_line(result, model), ""] if _vehicle_line(result, model) else []),
+          f"`before` and `after` are {measure} of each output; the minimised one is "
+          f"{measure_label(cfg, setup, s.measure)}. `change` is signed (negative: better) and `worse` is true "
+          "where the optimum is worse than before.", "",
+          markdown_table(ba.table, digits=5), ""]
+    if len(worse):
+        md += ["**Worse after optimisation:** " + ", ".join(
+            f"{r['output']} ({_signed(r['change'], True)})" for _, r in worse.iterrows())
+               + " — only the objective output was minimised; the others are shown, not optimised.", ""]
+    md += [f"Active bounds at the optimum: {', '.join(ba.active) if ba.active else 'none'}. The thesis approximation "
+           f"(4.71)–(4.73) reads {ba.thesis:.5g} at this optimum against the certified maximum {ba.exact:.5g} "
+           f"({100 * (ba.thesis - ba.exact) / ba.exact:+.2f} %).", ""]
     for o, f_hz, before, after, unit in ba.frfs:
         fig = plot_before_after(f_hz, before, after, f"{model}: {o} before and after optimisation", unit)
         name = writer.figure(fig, f"{o}_before_after{tag}", dpi=dpi)
         md += [f"![{o}]({name})", ""]
     if ba.stability is not None:
-        writer.table(ba.stability, f"stability{tag}")
+        writer.table(_csv(result, ba.stability, model), f"stability{tag}")
+        texts = _speeds(result, model, ba.stability.columns)
+        shown = ba.stability.copy()
+        if texts and "check" in shown.columns:  # the hunting check's value is the lowest critical speed
+            hunting = (shown["check"] == "hunting") & np.isposinf(shown["value"].astype(float))
+            shown["value"] = shown["value"].astype(object).where(~hunting, next(iter(texts.values())))
         md += ["Stability before and after (every distinct optimum's checks are in `optima.csv`):", "",
-               markdown_table(ba.stability, digits=5), ""]
+               markdown_table(shown, digits=5, infinite=texts), ""]
     if ba.loci is not None:
         fig = plot_root_loci_before_after(ba.loci, f"{model}: velocity root loci before and after (rigid track)")
         name = writer.figure(fig, f"root_locus_before_after{tag}", dpi=dpi)
-        writer.table(pd.concat([d.assign(design=k) for k, d in ba.loci.items()]), f"root_locus_before_after{tag}")
+        writer.table(_csv(result, pd.concat([d.assign(design=k) for k, d in ba.loci.items()]), model),
+                     f"root_locus_before_after{tag}")
         md += [f"![root loci]({name})", ""]
     return md
 
@@ -115,8 +210,8 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
 def _tradeoff(result: CampaignResult, s: ModelSections, t: Tradeoff, writer: Writer) -> list[str]:
     names = [v.name for v in result.config.design.variables]
     stem, q, spec = f"{t.spec.name}{s.tag}", t.quantity, t.spec
-    writer.table(t.table, f"tradeoff_{stem}")
-    writer.table(t.front, f"pareto_{stem}")
+    writer.table(_csv(result, t.table, s.model), f"tradeoff_{stem}")
+    writer.table(_csv(result, t.front, s.model), f"pareto_{stem}")
     writer.figure(plot_tradeoff(t.table, q, f"{s.model}: U against {q} ({spec.name})", required=t.required),
                   f"pareto_{stem}", dpi=result.config.report.dpi)
     how = ("the constrained problem solved with the stability rows required up to each speed"
@@ -129,13 +224,16 @@ def _tradeoff(result: CampaignResult, s: ModelSections, t: Tradeoff, writer: Wri
           f"{len(t.front)} non-dominated designs among the {len(t.table) - missed} of {len(t.table)} distinct "
           f"designs (sweep optima and every start; `count` = how many identical designs each row stands for) that "
           f"meet every other constraint of the constrained problem ({_others(result, spec)}); the {missed} that do "
-          f"not are listed in `tradeoff_{stem}.csv` (`feasible` False) and drawn apart; `pareto_{stem}.csv`:", "",
-          markdown_table(t.front[["source", "count", "U", q, *names]].head(12), digits=5), ""]
+          f"not are listed in `tradeoff_{stem}.csv` (`feasible` False) and drawn apart; U is the "
+          f"{measure_label(result.config, result.config.setups()[s.model], s.measure)}; `pareto_{stem}.csv`:", "",
+          markdown_table(t.front[["source", "count", "U", q, *names]].head(12), digits=5,
+                         infinite=_speeds(result, s.model, [q])), ""]
     if t.required is not None:
         sense = "≥" if spec.check is not None else "≤"
         if t.pick is not None:
+            shown = _speeds(result, s.model, [q]).get(q) if np.isposinf(t.pick[q]) else f"{t.pick[q]:.4g}"
             md += [f"Best design with {q} {sense} {t.required:.4g} that meets every constraint and the whole "
-                   f"stability criterion: U = {t.pick['U']:.5g}, {q} = {t.pick[q]:.4g}.", ""]
+                   f"stability criterion: U = {t.pick['U']:.5g}, {q} = {shown}.", ""]
             rec = s.recommended
             if rec is not None and t.pick["U"] < rec.U * (1 - 1e-6):
                 md += [f"**It beats the recommended design (U = {rec.U:.5g})**, which is the best certified optimum "
@@ -167,16 +265,17 @@ def tradeoffs_section(result: CampaignResult, s: ModelSections, writer: Writer) 
 def _surface(result: CampaignResult, s: ModelSections, g: TradeoffSurfaces, writer: Writer) -> list[str]:
     a, b = g.spec.variables
     stem = f"surface_{a}_{b}{s.tag}"
-    writer.table(g.constrained.to_pandas(), f"{stem}_constrained")
-    writer.table(g.unconstrained.to_pandas(), f"{stem}_unconstrained")
+    writer.table(_csv(result, g.constrained.to_pandas(), s.model), f"{stem}_constrained")
+    writer.table(_csv(result, g.unconstrained.to_pandas(), s.model), f"{stem}_unconstrained")
     for bd in g.boundaries:
-        writer.table(g.constrained.to_pandas().assign(**{bd.label.split(" ")[0]: bd.values.ravel()}),
-                     f"{stem}_{bd.label.split(' ')[0].replace(' ', '_')}")
+        writer.table(_csv(result, g.constrained.to_pandas().assign(**{bd.label.split(" ")[0]: bd.values.ravel()}),
+                          s.model), f"{stem}_{bd.label.split(' ')[0].replace(' ', '_')}")
     writer.figure(plot_surfaces(g.constrained, g.unconstrained, f"{s.model}: U over {a} × {b}",
                                 boundaries=g.boundaries, marks=g.marks, units=g.units), stem,
                   dpi=result.config.report.dpi)
     cmin, umin = g.constrained.minimum(), g.unconstrained.minimum(inside_only=False)
-    md = [f"Objective surface over {g.spec.variables} (others at the {next(iter(g.marks), 'optimum')} design): "
+    md = [f"Objective surface over {g.spec.variables} (others at the {next(iter(g.marks), 'optimum')} design; U is the "
+          f"{measure_label(result.config, result.config.setups()[s.model], s.measure)}): "
           f"least U on the constrained grid {cmin['U']:.4g} at {cmin[a]:.4g}, {cmin[b]:.4g}; on the grid relaxed "
           f"toward zero {umin['U']:.4g} at {umin[a]:.4g}, {umin[b]:.4g}."]
     for bd in g.boundaries:
@@ -208,61 +307,105 @@ def surfaces_section(result: CampaignResult, s: ModelSections, writer: Writer) -
 
 
 def _value(x: object, digits: int = 5) -> str:
-    return "" if x is None or (isinstance(x, float) and not np.isfinite(x)) else f"{x:.{digits}g}"
+    if x is None or (isinstance(x, float) and np.isnan(x)):
+        return ""
+    if isinstance(x, float) and np.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return f"{x:.{digits}g}"
+
+
+def _design_table(result: CampaignResult, s: ModelSections, rec: Recommended, ref: dict | None) -> pd.DataFrame:
+    """The quantity rows of one recommended design beside the existing design and the unconstrained optimum: the
+    variables, U in its measure, the signed change against the existing design, the reduction factor, the other
+    measures (side rows, not minimised), every check's numbers (an infinite critical speed in words) and every
+    constraint's peak."""
+    cfg = result.config
+    setup = cfg.setups()[s.model]
+    names = [v.name for v in cfg.design.variables]
+    speeds = _speeds(result, s.model, [k for payload in rec.checks.values() for k in payload])
+    table: list[tuple[str, str, str, str]] = []
+
+    def add(label, ex, r, u, key=None):
+        def cell(v):
+            if isinstance(v, str):
+                return v
+            if key in speeds and isinstance(v, float) and np.isposinf(v):
+                return speeds[key]
+            return _value(v)
+
+        table.append((label, cell(ex), cell(r), cell(u)))
+
+    ex_values = result.named.get(s.model, {})
+    for n in names:
+        add(n, ex_values.get(n), rec.values[n], None if ref is None else ref["values"][n])
+    missing = f"does not exist ({rec.existing_reason})" if rec.existing_reason else rec.existing_U
+    add(f"U: {measure_label(cfg, setup, rec.measure)}", missing, rec.U, None if ref is None else ref["U"])
+    if rec.existing_U is not None:
+        add("change against existing (negative: better)", None, _signed(*change(rec.existing_U, rec.U)),
+            None if ref is None else _signed(*change(rec.existing_U, ref["U"])))
+        add("reduction factor against existing (existing / U)", 1.0, rec.existing_U / rec.U,
+            None if ref is None else rec.existing_U / ref["U"])
+    for measure, (existing, value) in (rec.side or {}).items():
+        add(f"side measure, not minimised: {measure_label(cfg, setup, measure)}", existing, value,
+            None if ref is None else ref["side"].get(measure))
+    for name, payload in rec.checks.items():
+        for key, value in payload.items():
+            if isinstance(value, bool):
+                continue
+            ex_check = result.existing_checks.get(s.model, {}).get(name, {})
+            ref_value = None if ref is None else ref["checks"][name].payload().get(key)
+            add(key, ex_check.get(key), value, ref_value, key)
+    for c in rec.constraints:
+        ref_peak = None if ref is None else next(
+            r["peak"] for r in ref["constraints"] if r["output"] == c["output"])
+        add(f"{c['output']} peak (limit {c['limit']:.4g})", None, c["peak"], ref_peak)
+    return pd.DataFrame(table, columns=["quantity", "existing", "recommended", "unconstrained optimum"])
 
 
 def recommended_section(result: CampaignResult, writer: Writer) -> list[str]:
-    """recommended.csv (one row per model: variables, element values, U, critical speeds, constraint peaks) and
-    the summary's first section: the recommended design beside the existing one and the unconstrained optimum."""
-    rows = [s.recommended.row() for s in result.sections if s.recommended is not None]
+    """recommended.csv (one row per model and measure: the measure, variables, element values, U and the existing
+    design's U in it, the signed change, the other measures, critical speeds, constraint peaks) and the summary's
+    first section: per model the recommended design in the headline measure (the one its objective minimised)
+    beside the existing one and the unconstrained optimum, then in the study's other measure, if any."""
+    rows = [r.row() for s in result.sections if s.recommended is not None for r in s.recommended.all()]
     if rows:
-        writer.table(pd.DataFrame(rows), "recommended")
+        writer.table(_csv(result, pd.DataFrame(rows)), "recommended")
     cfg = result.config
-    names = [v.name for v in cfg.design.variables]
     md: list[str] = []
     for s in result.sections:
-        rec, ref = s.recommended, s.unconstrained
-        md += [f"## Recommended design: {s.model}", ""]
+        rec = s.recommended
+        vehicle = _vehicle_line(result, s.model)
+        md += [f"## Recommended design: {s.model}", "", *([vehicle, ""] if vehicle else [])]
         if rec is None:
             md += ["**No recommended design**: no optimum of the constrained problem passes every check and "
-                   "constraint (see `optima.csv`).", ""]
+                   "constraint (see `optima.csv` and the outcome of every start below).", ""]
             continue
-        table: list[tuple[str, str, str, str]] = []
-
-        def add(label, ex, r, u, table=table):
-            table.append((label, *(v if isinstance(v, str) else _value(v) for v in (ex, r, u))))
-
-        ex_values = result.named.get(s.model, {})
-        for n in names:
-            add(n, ex_values.get(n), rec.values[n], None if ref is None else ref["values"][n])
-        add(f"U: peak {cfg.objective.output} (certified)", rec.existing_U, rec.U, None if ref is None else ref["U"])
-        add("reduction factor against existing", 1.0 if rec.existing_U else None,
-            rec.existing_U / rec.U if rec.existing_U else None,
-            rec.existing_U / ref["U"] if rec.existing_U and ref is not None else None)
-        for name, payload in rec.checks.items():
-            for key, value in payload.items():
-                if isinstance(value, bool):
-                    continue
-                ex_check = result.existing_checks.get(s.model, {}).get(name, {})
-                ref_value = None if ref is None else ref["checks"][name].payload().get(key)
-                add(key, ex_check.get(key), value, ref_value)
-        for c in rec.constraints:
-            ref_peak = None if ref is None else next(
-                r["peak"] for r in ref["constraints"] if r["output"] == c["output"])
-            add(f"{c['output']} peak (limit {c['limit']:.4g})", None, c["peak"], ref_peak)
-        columns = pd.DataFrame(table, columns=["quantity", "existing", "recommended", "unconstrained optimum"])
-        verdict = ", ".join(f"{k} {'yes' if v else 'NO'}" for n, p in rec.checks.items()
-                            for k, v in p.items() if isinstance(v, bool))
-        md += [f"The best distinct optimum of the {rec.source['problem']} problem ({rec.source['objective']} "
-               f"objective, {rec.source['method']}, start {rec.source['start_id']}) that passes every check "
-               f"({verdict}) and meets every constraint; written to `recommended.csv` (element values in SI):", "",
-               markdown_table(columns), ""]
-        if ref is not None:
-            failing = [f"{n}: {k}" for n, r in ref["checks"].items() for k, v in r.flags.items() if not v]
-            note = ("it fails the check(s) " + ", ".join(f"{f} (is false)" for f in failing)
-                    + " — shown for comparison only, not recommendable"
-                    if failing else "it passes every check")
-            md += [f"The unconstrained optimum (the objective alone): U = {_value(ref['U'])}; {note}.", ""]
+        setup = cfg.setups()[s.model]
+        for k, r in enumerate(rec.all()):
+            ref = s.unconstrained if k == 0 else None  # the unconstrained optimum is judged in the headline measure
+            relative, worse = change(r.existing_U, r.U)
+            existing = (f" against the existing design, where it does not exist ({r.existing_reason})"
+                        if r.existing_reason else f" against {_value(r.existing_U)} for the existing design"
+                        if r.existing_U is not None else " (the model has no existing design to compare)")
+            verdict = ", ".join(f"{key} {'yes' if v else 'NO'}" for payload in r.checks.values()
+                                for key, v in payload.items() if isinstance(v, bool))
+            heading = ("" if k == 0 else f"### In the study's other measure ({r.measure}: the "
+                       f"`{'`, `'.join(o for o in dict.fromkeys(cfg.design.objectives) if MEASURES[o] == r.measure)}`"
+                       " campaigns)")
+            md += ([heading, ""] if heading else []) + [
+                f"Minimised: {measure_label(cfg, setup, r.measure)}. **U = {_value(r.U)}{existing}"
+                + (f": {_signed(relative, worse)}" if relative is not None else "") + ".**", "",
+                f"The best distinct optimum of the {r.source['problem']} problem ({r.source['objective']} "
+                f"objective, {r.source['method']}, start {r.source['start_id']}) that passes every check "
+                f"({verdict}) and meets every constraint; written to `recommended.csv` (`measure` {r.measure}; "
+                "element values in SI):", "",
+                markdown_table(_design_table(result, s, r, ref)), ""]
+            if ref is not None:
+                failing = [f"{n}: {key}" for n, res in ref["checks"].items() for key, v in res.flags.items() if not v]
+                note = ("it fails the check(s) " + ", ".join(f"{f} (is false)" for f in failing)
+                        + " — shown for comparison only, not recommendable"
+                        if failing else "it passes every check")
+                md += [f"The unconstrained optimum (the objective alone): U = {_value(ref['U'])}; {note}.", ""]
     return md
 
 

@@ -1,20 +1,26 @@
-"""Report sections of the ``campaign`` kind: the comparison rows, the FRF panels at the optima, the before/after
-of a named design against the optimum, and each model's sections (before/after, trade-offs, surfaces)."""
+"""Report sections of the ``campaign`` kind: the comparison rows, the outcome of every start, the FRF panels at the
+optima, the before/after of a named design against the optimum, each model's sections (before/after, trade-offs,
+surfaces) in the measure its objective minimised, and the vehicle each model is built from."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from railopt.design.result import FEASIBILITY_TOL
 from railopt.models.stability import root_locus
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.models.units import m_to_in
-from railopt.studies.adapter import response_target
+from railopt.models.vehicle import load_vehicle
+from railopt.models.vehicle.loader import bundled_vehicles
+from railopt.studies.adapter import objective_value, response_target, rms_target
 from railopt.studies.catalog import ModelSetup
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
 from railopt.studies.kinds.campaign.problems import (
+    MEASURES,
     FeasibleDesign,
     _DesignValues,
     _p,
@@ -22,8 +28,11 @@ from railopt.studies.kinds.campaign.problems import (
     _sweep_problems,
     campaign_problem,
     design_peak,
+    design_value,
+    section_objective,
+    study_measures,
 )
-from railopt.studies.kinds.campaign.selection import Recommended, _active_bounds, _unconstrained_best
+from railopt.studies.kinds.campaign.selection import Recommended, _active_bounds, _unconstrained_best, change
 from railopt.studies.kinds.campaign.tradeoffs import (
     Tradeoff,
     TradeoffSurfaces,
@@ -33,7 +42,7 @@ from railopt.studies.kinds.campaign.tradeoffs import (
 )
 from railopt.studies.output.records import FrfPanel
 
-__all__ = ["BeforeAfter", "ModelSections"]
+__all__ = ["BeforeAfter", "ModelSections", "model_vehicles", "outcome_counts", "start_outcomes"]
 
 
 @dataclass(frozen=True)
@@ -62,16 +71,102 @@ class ModelSections:
     surfaces: list[TradeoffSurfaces] = field(default_factory=list)
     recommended: Recommended | None = None
     unconstrained: dict | None = None
+    measure: str = "peak"  # what U is in these sections: the measure the objective minimised (MEASURES)
+
+
+# ---------------------------------------------------------------------------------------------- vehicles
+def model_vehicles(cfg: CampaignStudyConfig) -> dict[str, dict[str, str]]:
+    """The vehicle of each ``[[models]]`` entry built from a vehicle file, by label: ``{"vehicle": its name (the
+    file's ``[vehicle] name``), "vehicle_file": the file}`` — a bundled one as ``"<name>.toml (bundled)"``, another
+    by its path relative to the working directory when under it.  Models without a vehicle (``tmd``) are absent."""
+    bundled = bundled_vehicles()
+    out = {}
+    for i, ref in enumerate(cfg.models):
+        source = getattr(ref.validated_options(f"models[{i}]"), "vehicle", None)
+        if not isinstance(source, str):
+            continue
+        vehicle = load_vehicle(source)
+        if source in bundled:
+            shown = f"{source}.toml (bundled)"
+        else:
+            path = Path(vehicle.path).resolve()
+            shown = str(path.relative_to(Path.cwd())) if path.is_relative_to(Path.cwd()) else str(path)
+        out[ref.label] = {"vehicle": vehicle.name, "vehicle_file": shown}
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- start outcomes
+OUTCOMES: dict[str, str] = {
+    "optimum": "converged to a feasible design (success)",
+    "objective does not exist": "U = inf where the solve ended: the objective does not exist there (an unstable "
+                                "design: no steady-state or stationary random response; an undamped mode in the "
+                                "band: an unbounded maximum); a start placed there cannot move",
+    "infeasible": "the solve ended outside the constraints (violation above the feasibility tolerance)",
+}
+"""The outcomes of a start beside the design layer's statuses (a start that ends otherwise is counted under its
+status, ``maxeval``, ``failure``, ``error``, ..., with its message as the reason)."""
+
+
+def start_outcomes(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], starts: pd.DataFrame) -> pd.DataFrame:
+    """``starts`` (the campaigns' starts: ``model``, ``objective``, the variables, ``value``, ``status``,
+    ``message``, ``success``, ``constraint_violation``) with ``outcome`` (a key of :data:`OUTCOMES`, or the
+    status) and ``reason``: for U = inf, why the objective does not exist at the start's final design (recomputed
+    there by :func:`railopt.studies.adapter.objective_value`, "at its start" when it never moved); for an
+    infeasible end, the violation; otherwise the solver's message.  Nothing is dropped: every start has a row."""
+    names = [v.name for v in cfg.design.variables]
+    outcomes, reasons = [], []
+    for _, r in starts.iterrows():
+        if bool(r["success"]):
+            outcome, reason = "optimum", ""
+        elif not np.isfinite(float(r["value"])):
+            setup = setups[r["model"]]
+            values = {n: float(r[n]) for n in names}
+            target = (rms_target(cfg.objective, setup) if MEASURES[r["objective"]] == "rms"
+                      else response_target(cfg.objective, setup, exact=r["objective"] == "exact"))
+            value, why = objective_value(setup.family.at(_p(cfg, setup, values)), target)
+            if np.isfinite(value):  # the design layer's U is inf for another reason (a lost worker, an error)
+                outcome, reason = str(r["status"]), str(r["message"])
+            else:
+                moved = not np.allclose([float(r[n]) for n in names], [float(r[f"x0_{n}"]) for n in names],
+                                        rtol=1e-9, atol=0.0)
+                outcome, reason = "objective does not exist", why + ("" if moved else " (at its start)")
+        elif float(r["constraint_violation"]) > FEASIBILITY_TOL:
+            outcome, reason = "infeasible", f"constraint violation {float(r['constraint_violation']):.3g}"
+        else:
+            outcome, reason = str(r["status"]), str(r["message"])
+        outcomes.append(outcome)
+        reasons.append(reason)
+    return starts.assign(outcome=outcomes, reason=reasons)
+
+
+def outcome_counts(starts: pd.DataFrame) -> pd.DataFrame:
+    """Per campaign (model, problem, objective, method) and outcome: the number of starts and the distinct
+    reasons (the first three, with how many more), from :func:`start_outcomes`' table."""
+    keys = [k for k in ("model", "problem", "objective", "method") if k in starts.columns]
+    rows = []
+    for key, group in starts.groupby([*keys, "outcome"], sort=False):
+        reasons = list(dict.fromkeys(x for x in group["reason"] if x))
+        shown = "; ".join(reasons[:3]) + (f"; and {len(reasons) - 3} more" if len(reasons) > 3 else "")
+        rows.append({**dict(zip([*keys, "outcome"], key, strict=True)), "starts": len(group), "reasons": shown})
+    return pd.DataFrame(rows, columns=[*keys, "outcome", "starts", "reasons"])
 
 
 # ---------------------------------------------------------------------------------------------- comparison
 def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, str, str],
                     table: pd.DataFrame, optima: pd.DataFrame, flags: list[str]) -> dict:
+    """One row of ``comparison.csv``: the campaign's counts, its best design passing the checks, that design's
+    ``U_objective`` (the campaign's own value: the thesis approximation, the certified peak or the RMS), its
+    ``true_peak`` (certified) and, in a study with an ``rms`` objective, its ``true_rms``; against each
+    ``report.compare`` design: its peak (``<ref>_peak``), its RMS (``<ref>_rms``) and ``change_vs_<ref>``, signed,
+    in the campaign's own measure (negative: the best design is better)."""
     names = [v.name for v in cfg.design.variables]
     model, problem, objective, method = key
+    measure = MEASURES[objective]
+    with_rms = "rms" in study_measures(cfg)
     ok = table[table["success"]]
-    row: dict = {"model": model, "problem": problem, "objective": objective, "method": method, "starts": len(table),
-                 "converged": int(table["success"].sum()), "success_rate": float(table["success"].mean()),
+    row: dict = {"model": model, "problem": problem, "objective": objective, "method": method, "measure": measure,
+                 "starts": len(table), "converged": int(table["success"].sum()),
+                 "success_rate": float(table["success"].mean()),
                  "distinct_optima": len(optima), "evaluations": int(table["evaluations"].sum()),
                  "wall_time_s": float(table["wall_time"].sum())}
     flags = [f for f in flags if f in optima.columns]  # no optima: no check columns
@@ -88,13 +183,18 @@ def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str,
         values = {n: float(best[n]) for n in names}
         peak = design_peak(cfg, setup, values)
         row |= {**values, "U_objective": float(best["value"]), "true_peak": peak,
-                "objective_underestimate": (peak - float(best["value"])) / peak,
+                "objective_underestimate": (peak - float(best["value"])) / peak if measure == "peak" else np.nan,
                 "best_start": int(best["start_id"])}
+        if with_rms:
+            row["true_rms"] = design_value(cfg, setup, "rms", values)[0]
+        own = row["true_rms"] if measure == "rms" else peak
         for ref in cfg.report.compare:
             ref_values = setup.named_designs[ref]
-            ref_peak = design_peak(cfg, setup, ref_values)
-            row[f"{ref}_peak"] = ref_peak
-            row[f"change_vs_{ref}"] = (peak - ref_peak) / ref_peak
+            row[f"{ref}_peak"] = design_peak(cfg, setup, ref_values)
+            if with_rms:
+                row[f"{ref}_rms"] = design_value(cfg, setup, "rms", ref_values)[0]
+            relative = change(row[f"{ref}_{measure}"], own)[0]
+            row[f"change_vs_{ref}"] = np.nan if relative is None else relative
             for n in names:
                 row[f"{n}_change_vs_{ref}"] = values[n] - ref_values[n]
         row["active_bounds"] = "; ".join(_active_bounds(cfg, values)) or "none"
@@ -102,8 +202,8 @@ def _comparison_row(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str,
 
 
 def _short(comparison: pd.DataFrame, names: list[str]) -> pd.DataFrame:
-    cols = ["model", "problem", "objective", "method", *names, "U_objective", "true_peak", "converged", "starts",
-            "distinct_optima"]
+    cols = ["model", "problem", "objective", "method", *names, "U_objective", "true_peak", "true_rms", "converged",
+            "starts", "distinct_optima"]
     cols += [c for c in comparison.columns if c.startswith("change_vs_")]
     return comparison[[c for c in cols if c in comparison.columns]]
 
@@ -126,7 +226,8 @@ def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], compari
             p = _p(cfg, setup, {n: r[n] for n in names})
             label = f"{r['problem']} {r['objective']}/{r['method']}" if len(cfg.design.problems) > 1 else \
                 f"railopt {r['objective']}/{r['method']}"
-            curves.append((f"{label} (peak {r['true_peak']:.6g})", f_hz,
+            rms = f"RMS {r['true_rms']:.4g}, " if MEASURES[r["objective"]] == "rms" else ""
+            curves.append((f"{label} ({rms}peak {r['true_peak']:.6g})", f_hz,
                            np.abs(setup.family.at(p).frf(frequencies_hz=f_hz, output=target.output)),
                            r["objective"]))
         panels.append(FrfPanel.build(f"{model}: {setup.description}", setup.axis_label(target.output), curves))
@@ -147,9 +248,11 @@ def _where(rm) -> str:
 
 
 def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, float],
-                  band: tuple[float, float]) -> BeforeAfter:
-    """Maxima, FRFs, checks and (with forward speed) root loci of the named design ``report.before`` and the
-    optimum ``after`` (Figs 4.13–4.17)."""
+                  band: tuple[float, float], measure: str = "peak") -> BeforeAfter:
+    """Maxima (or RMS), FRFs, checks and (with forward speed) root loci of the named design ``report.before`` and
+    the optimum ``after`` (Figs 4.13–4.17).  ``before``/``after`` are in ``measure`` (the certified band maximum,
+    or the RMS per metre under the spectrum with the certified maxima as ``peak_…`` side columns), with the
+    signed relative ``change`` (negative: better) and ``worse`` (after > before) beside the reduction factor."""
     p_before = _p(cfg, setup, setup.named_designs[cfg.report.before])
     p_after = _p(cfg, setup, after)
     sys_b, sys_a = setup.family.at(p_before), setup.family.at(p_after)
@@ -158,12 +261,22 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
     for o in outputs:
         rb = sys_b.response_maxima(band_rad_s=band, exact=True, output=o)
         ra = sys_a.response_maxima(band_rad_s=band, exact=True, output=o)
-        row = {"output": o, "before": rb.value, "after": ra.value, "reduction_factor": rb.value / ra.value,
-               "before_at_hz": rb.argmax_frequency / HZ, "before_peak_is": _where(rb),
-               "after_at_hz": ra.argmax_frequency / HZ, "after_peak_is": _where(ra),
-               "certified": rb.certified and ra.certified}
-        if o in cfg.report.inch_outputs:
-            row |= {"before_in": m_to_in(rb.value), "after_in": m_to_in(ra.value)}  # in, in/s or in/s² by quantity
+        peaks = {"before": rb.value, "after": ra.value, "before_at_hz": rb.argmax_frequency / HZ,
+                 "before_peak_is": _where(rb), "after_at_hz": ra.argmax_frequency / HZ, "after_peak_is": _where(ra),
+                 "certified": rb.certified and ra.certified}
+        if measure == "rms":
+            target = rms_target(cfg.objective.model_copy(update={"output": o}), setup)
+            (vb, why_b), (va, why_a) = objective_value(sys_b, target), objective_value(sys_a, target)
+            main, side = {"before": vb, "after": va}, {f"peak_{k}": v for k, v in peaks.items()}
+            side |= {k: why for k, why in (("before_reason", why_b), ("after_reason", why_a)) if why}
+        else:
+            main, side = {"before": rb.value, "after": ra.value}, {k: v for k, v in peaks.items()
+                                                                   if k not in ("before", "after")}
+        relative, worse = change(main["before"], main["after"])
+        row = {"output": o, "measure": measure, **main, "change": relative, "worse": worse,
+               "reduction_factor": main["before"] / main["after"], **side}
+        if o in cfg.report.inch_outputs:  # in, in/s or in/s² by quantity
+            row |= {"before_in": m_to_in(main["before"]), "after_in": m_to_in(main["after"])}
         if o in cfg.report.published:
             pb, pa = cfg.report.published[o]
             row |= {"published_before": pb, "published_after": pa, "published_factor": pb / pa}
@@ -193,20 +306,23 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
 def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, comparison: pd.DataFrame,
                     tables: dict, tag: str, client, recommended: Recommended | None) -> ModelSections:
     """The before/after, trade-off and surface sections of one model, at its recommended design (or, without
-    one, its best optimum passing the checks of the exact objective, or of the first objective)."""
+    one, its best optimum passing the checks of the exact objective, or of the first objective), in the measure
+    of the recommended design (:data:`MEASURES`): the sweeps solve that measure's objective and U is in it."""
     names = [v.name for v in cfg.design.variables]
-    objective = "exact" if "exact" in cfg.design.objectives else cfg.design.objectives[0]
+    objective = section_objective(cfg, recommended.measure if recommended is not None else None)
+    measure = MEASURES[objective]
     rows = comparison[(comparison["model"] == model) & (comparison["objective"] == objective)
                       & (comparison["problem"] == cfg.design.problems[0])]
-    rows = rows[np.isfinite(rows["true_peak"])] if "true_peak" in rows.columns else rows.iloc[0:0]
+    judged = f"true_{measure}"
+    rows = rows[np.isfinite(rows[judged])] if judged in rows.columns else rows.iloc[0:0]
     if rows.empty and recommended is None:
-        return ModelSections(model, tag, None, objective)
-    best = rows.sort_values("true_peak").iloc[0] if len(rows) else None
+        return ModelSections(model, tag, None, objective, measure=measure)
+    best = rows.sort_values(judged).iloc[0] if len(rows) else None
     after = dict(recommended.values) if recommended is not None else {n: float(best[n]) for n in names}
     if best is None or recommended is not None:
-        best = pd.Series({**after, "true_peak": recommended.U, **recommended.source})
+        best = pd.Series({**after, judged: recommended.U, **recommended.source})
     band = response_target(cfg.objective, setup, exact=True).band
-    before_after = _before_after(cfg, setup, after, band) if cfg.report.before else None
+    before_after = _before_after(cfg, setup, after, band, measure) if cfg.report.before else None
     starts = pd.concat([t.assign(problem=prob) for (m, prob, o, _), t in tables.items() if m == model])
     x_after = np.array([after[n] for n in names])
     tradeoffs = []
@@ -221,10 +337,10 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
             required = limits[0] if limits else None
         tradeoffs.append(tradeoff_table(
             spec, _sweep_problems(cfg, setup, objective, spec), starts, _quantity(cfg, setup, spec),
-            lambda x: design_peak(cfg, setup, dict(zip(names, x, strict=True))), cfg.design.seed,
+            lambda x: design_value(cfg, setup, measure, dict(zip(names, x, strict=True)))[0], cfg.design.seed,
             points=[list(x_after)], client=client, required=required, feasible=FeasibleDesign(cfg, setup, spec),
             criterion=(FeasibleDesign(cfg, setup, None) if spec.check in ("hunting", "damping") else None)))
-    reference = _unconstrained_best(cfg, setup, model, tables)
+    reference = _unconstrained_best(cfg, setup, model, tables, measure)
     marks = {"recommended" if recommended is not None else "optimum": after}
     if reference is not None:
         marks["unconstrained optimum"] = reference["values"]
@@ -240,4 +356,5 @@ def _model_sections(cfg: CampaignStudyConfig, model: str, setup: ModelSetup, com
              for spec in cfg.surfaces]
     if recommended is not None:  # grid points that beat the recommendation: do they meet everything?
         grids = [grid_points_below(g, after, recommended.U, FeasibleDesign(cfg, setup, None), names) for g in grids]
-    return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids, recommended, reference)
+    return ModelSections(model, tag, best, objective, before_after, tradeoffs, grids, recommended, reference,
+                         measure)
