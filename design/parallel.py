@@ -17,6 +17,11 @@ Failures the dask paths turn into one clear exception (never a dask traceback, n
   goes away during the run: :class:`SchedulerError` (a ``ConnectionError``) naming the address and the
   way out, within the scheduler timeout plus :data:`SCHEDULER_MARGIN` seconds.
 
+What a cluster did is recorded (:func:`cluster_record`): the workers at the start, at the end and the most seen,
+the workers lost while a map ran and how many of its tasks they were running — tasks the scheduler re-ran on
+other workers, which changes no result (every task is self-contained) but must be said (``railopt run`` prints it
+and writes it to ``timing.csv``).
+
 Logs.  While a client made by :func:`dask_client` is open, dask's own log lines (warnings about
 restarted workers, cancelled instructions at shutdown) are kept out of the terminal: set
 ``$RAILOPT_DASK_LOGS`` to a level name (e.g. ``WARNING``) to see them.  The workers of the embedded
@@ -31,12 +36,13 @@ import math
 import numbers
 import os
 import queue
+import signal
 import threading
 import time
 import weakref
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, fields, is_dataclass
+from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any
 
@@ -95,6 +101,125 @@ class _ClientInfo:
 
 
 _CLIENTS: weakref.WeakKeyDictionary[Any, _ClientInfo] = weakref.WeakKeyDictionary()
+
+
+# ---------------------------------------------------------------------- what a cluster did
+@dataclass
+class ClusterRecord:
+    """What a client's cluster did while railopt used it (:func:`cluster_record`).
+
+    Attributes
+    ----------
+    address : str
+        The scheduler's address.
+    workers_at_start, workers_at_end, workers_max : int or None
+        Workers when the record began (the client was opened, or first used by :func:`map_unordered`), when
+        :func:`dask_client` closed it (``None`` until then, or when the scheduler did not answer), and the most
+        seen meanwhile (from the scheduler's add-worker and remove-worker events).
+    lost_workers : list of str
+        Addresses of the workers that left the cluster meanwhile (a crash, a killed process, a scaled-down
+        cluster), in order.
+    rerun_tasks : int
+        Tasks of :func:`map_unordered` that a lost worker was running or held the result of: the scheduler ran
+        them again on another worker (the result is the same: a task depends on nothing but itself).
+    """
+
+    address: str
+    workers_at_start: int | None = None
+    workers_at_end: int | None = None
+    workers_max: int | None = None
+    lost_workers: list[str] = field(default_factory=list)
+    rerun_tasks: int = 0
+    _live: set[str] = field(default_factory=set, repr=False)
+    _keys: set[Any] = field(default_factory=set, repr=False)
+
+    def _start(self, workers: Iterable[str]) -> None:
+        self._live = set(workers)
+        self.workers_at_start = self.workers_max = len(self._live)
+
+    def _event(self, event: Any) -> None:
+        """A scheduler event ``(time, message)`` of topic ``all`` (runs in the client's event-loop thread)."""
+        message = event[1] if isinstance(event, tuple | list) and len(event) == 2 else event
+        if not isinstance(message, dict):
+            return
+        action, worker = message.get("action"), message.get("worker")
+        if action == "add-worker" and worker:
+            self._live.add(worker)
+            self.workers_max = max(self.workers_max or 0, len(self._live))
+        elif action == "remove-worker" and worker:
+            self._live.discard(worker)
+            self.lost_workers.append(str(worker))
+            ours = {*(message.get("processing-tasks") or ()), *(message.get("lost-computed-tasks") or ())}
+            self.rerun_tasks += len(ours & self._keys)
+
+    def describe(self) -> str:
+        """One sentence on lost workers and re-run tasks (empty when there were none)."""
+        if not self.lost_workers:
+            return ""
+        n, k = len(self.lost_workers), self.rerun_tasks
+        shown = ", ".join(self.lost_workers[:3]) + (f" and {n - 3} more" if n > 3 else "")
+        tasks = (f"{k} task{' was' if k == 1 else 's were'} re-run on other workers (a task depends on nothing but "
+                 "itself: the results are unchanged)" if k else "no task of this run was running there")
+        lost = f"{n} dask worker{'' if n == 1 else 's'} left the cluster {self.address} during the run"
+        return f"{lost} ({shown}); {tasks}"
+
+
+def cluster_summary(records: Iterable[ClusterRecord]) -> dict[str, Any]:
+    """The columns ``timing.csv`` gives the clusters a run used (none: serial): ``workers_at_start`` (of the
+    first), ``workers_at_end`` (of the last; empty when its scheduler did not answer), ``workers_max``,
+    ``workers_lost`` and ``tasks_rerun`` (totals) and ``cluster_events`` (:meth:`ClusterRecord.describe`)."""
+    records = list(records)
+    if not records:
+        return {"workers_at_start": 0, "workers_at_end": 0, "workers_max": 0, "workers_lost": 0, "tasks_rerun": 0,
+                "cluster_events": ""}
+    end = records[-1].workers_at_end
+    return {"workers_at_start": records[0].workers_at_start, "workers_at_end": end,
+            "workers_max": max(r.workers_max or 0 for r in records),
+            "workers_lost": sum(len(r.lost_workers) for r in records),
+            "tasks_rerun": sum(r.rerun_tasks for r in records),
+            "cluster_events": "; ".join(r.describe() for r in records if r.describe())}
+
+
+_RECORDS: weakref.WeakKeyDictionary[Any, ClusterRecord] = weakref.WeakKeyDictionary()
+
+
+def cluster_record(client: Any) -> ClusterRecord | None:
+    """The :class:`ClusterRecord` of ``client`` (a client opened by :func:`dask_client`, or used by
+    :func:`map_unordered`); ``None`` for ``None`` (serial) or a client railopt never used."""
+    return None if client is None else _RECORDS.get(client)
+
+
+def _track(client: Any, timeout: float) -> ClusterRecord:
+    """The record of ``client``, begun now if it has none: the workers now, then the scheduler's events."""
+    record = _RECORDS.get(client)
+    if record is not None:
+        return record
+    record = ClusterRecord(_address(client))
+    record._start(_workers(client, timeout) or {})
+    try:
+        previous = getattr(client, "_event_handlers", {}).get("all")
+
+        def handler(event: Any) -> None:
+            record._event(event)
+            if previous is not None:  # a handler the user had: still called
+                previous(event)
+
+        client.subscribe_topic("all", handler)
+    except Exception:  # noqa: BLE001, S110  (a Runner without events: the counts at start and end only)
+        pass
+    _RECORDS[client] = record
+    return record
+
+
+def _finish(client: Any, timeout: float) -> None:
+    """The workers at the end, asked before the client closes (``workers_at_end`` stays None without an answer)."""
+    record = _RECORDS.get(client)
+    if record is None:
+        return
+    workers = _workers(client, timeout)
+    if workers is not None:
+        record.workers_at_end = len(workers)
+        record.workers_max = max(record.workers_max or 0, len(workers))
 
 
 # ---------------------------------------------------------------------- pickling
@@ -207,10 +332,12 @@ def map_unordered(
     from distributed import as_completed
 
     info = _CLIENTS.get(client) or _ClientInfo(_address(client), scheduler_timeout(), True)
+    record = _track(client, info.timeout)
     try:
         futures = client.map(task, items, pure=False, retries=retries)
     except Exception as exc:  # e.g. the connection is gone already
         raise _lost(info, exc) from None
+    record._keys.update(f.key for f in futures)  # a lost worker's event names the tasks it was running
     remaining = len(futures)
     item_of = {f.key: it for f, it in zip(futures, items, strict=True)}
     # only unfinished tasks are held: a finished one's future is dropped once its result is read, so the worker
@@ -469,7 +596,9 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
                         raise SchedulerError(_no_workers(info, wait, resume=False)) from None
                     if client.status != "running":
                         raise _lost(info, None) from None
+                _track(client, wait)
                 yield client
+                _finish(client, wait)
             finally:
                 _close(client, wait)
         return
@@ -486,27 +615,59 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     # worker after a restart (multistart re-runs a lost task's starts alone for that).  The cluster never gives up a
     # crashed worker for good: dask closes a nanny whose worker is still restarting 15 s after a crash
     # (lost-worker-timeout), which a run of crashing starts hits; our own limit is LOCAL_NO_WORKERS_LIMIT.
-    with (
-        _quiet_dask_logs(),
-        dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0,
-                         "distributed.deploy.lost-worker-timeout": "1000 days",
-                         # a worker's own threads take the GIL from the solving thread: its sampling profiler
-                         # (every 10 ms), the event-loop tick (20 ms), memory (100 ms) and system (500 ms) monitors
-                         "distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "200ms",
-                         "distributed.worker.memory.monitor-interval": "500ms",
-                         "distributed.admin.system-monitor.interval": "2s"}),
-        LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                     # the scheduler's HTTP routes on a free local port, not 8787 (taken: a warning on stderr)
-                     scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                     silence_logs=logging.ERROR, preload=[_worker_setup_source()]) as cluster,
-        Client(cluster) as client,
-    ):
-        _CLIENTS[client] = _ClientInfo(str(cluster.scheduler_address), wait, False)
-        yield client
+    # Ctrl-C while the cluster starts: SIGINT is blocked in this thread, and so in every thread and worker process
+    # started meanwhile (they inherit the mask), until the cluster is up; a Ctrl-C pressed meanwhile then lands
+    # here, in one place, and the cluster is shut down as after any interruption — no half-started cluster, no
+    # traceback of a worker process interrupted while importing
+    blocked = _block_sigint()
+    try:
+        with (
+            _quiet_dask_logs(),
+            dask.config.set({"distributed.scheduler.allowed-failures": 1,
+                             "distributed.scheduler.worker-saturation": 1.0,
+                             "distributed.deploy.lost-worker-timeout": "1000 days",
+                             # a worker's own threads take the GIL from the solving thread: its sampling profiler
+                             # (every 10 ms), the event-loop tick (20 ms), memory (100 ms) and system (500 ms)
+                             # monitors
+                             "distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "200ms",
+                             "distributed.worker.memory.monitor-interval": "500ms",
+                             "distributed.admin.system-monitor.interval": "2s"}),
+            LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                         # the scheduler's HTTP routes on a free local port, not 8787 (taken: a warning on stderr)
+                         scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                         silence_logs=logging.ERROR, preload=[_worker_setup_source()]) as cluster,
+            Client(cluster) as client,
+        ):
+            _unblock_sigint(blocked)  # a Ctrl-C pressed while the cluster started is raised here
+            _CLIENTS[client] = _ClientInfo(str(cluster.scheduler_address), wait, False)
+            _track(client, wait)
+            yield client
+            _finish(client, wait)
+    finally:
+        _unblock_sigint(blocked)
+
+
+def _block_sigint() -> set[int] | None:
+    """Block SIGINT in this thread (main thread only); the previous mask, or None when nothing was changed.
+
+    multiprocessing's resource tracker is started first: starting it unblocks SIGINT in the thread that does, which
+    would otherwise be the cluster's event-loop thread, and the workers it starts would not inherit the block."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+        return None
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    return set(signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}))
+
+
+def _unblock_sigint(previous: set[int] | None) -> None:
+    """Restore the mask :func:`_block_sigint` changed (a pending SIGINT is then delivered: KeyboardInterrupt)."""
+    if previous is not None and signal.SIGINT not in previous:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 __all__ = [
     "DASK_LOGS_ENV", "DEFAULT_SCHEDULER_TIMEOUT", "LOCAL_NO_WORKERS_LIMIT", "SCHEDULER_ENV", "SCHEDULER_MARGIN",
-    "SCHEDULER_TIMEOUT_ENV", "SchedulerError", "WorkerLost", "call", "check_picklable", "dask_client",
-    "map_unordered", "scheduler_timeout",
+    "SCHEDULER_TIMEOUT_ENV", "ClusterRecord", "SchedulerError", "WorkerLost", "call", "check_picklable",
+    "cluster_record", "cluster_summary", "dask_client", "map_unordered", "scheduler_timeout",
 ]

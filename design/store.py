@@ -20,9 +20,11 @@ store use ``CampaignStore.open(path, read_only=True)``, or plain SQLite::
 
 A reader that keeps a read transaction open (an unconsumed cursor) does not block the campaign,
 but the write-ahead log cannot be folded back into the file while it lasts, so finish reads
-promptly.  The ``<store>-wal`` and ``<store>-shm`` files next to a store are part of it while it is
-open (and after a writer was killed: the next open recovers the committed starts from them): copy
-or move a store only when no process has it open, with those files if they exist.
+promptly.  A *closed* store is back in the rollback journal, where such a reader does block a writer: opening
+it for writing (a ``--resume``) waits up to :data:`BUSY_TIMEOUT` s for the reader to finish, then refuses with a
+:class:`StoreError` naming the processes that hold the file open.  The ``<store>-wal`` and ``<store>-shm``
+files next to a store are part of it while it is open (and after a writer was killed: the next open recovers the
+committed starts from them): copy or move a store only when no process has it open, with those files if they exist.
 
 Starts that killed every worker they ran on are stored with status ``worker_lost`` (x = x0, value
 +inf); a resume skips them unless asked to retry them (``finished_ids(retry_failed=True)``), and a
@@ -129,15 +131,50 @@ def _marks(values: Sequence[object]) -> str:
     return ",".join("?" * len(values))
 
 
+def _holders(path: Path) -> list[str]:
+    """The other processes that have ``path`` (or its ``-wal``/``-shm``/``-journal`` file) open, as
+    ``"PID 123 (python3 notebook.py)"``, from ``/proc`` (Linux; elsewhere, or without permission, none are found)."""
+    targets = {os.path.realpath(f"{path}{extra}") for extra in ("", "-wal", "-shm", "-journal")}
+    found = []
+    for entry in Path("/proc").glob("[0-9]*") if Path("/proc/self/fd").is_dir() else ():
+        if int(entry.name) == os.getpid():
+            continue
+        try:
+            if not any(os.path.realpath(fd) in targets for fd in (entry / "fd").iterdir()):
+                continue
+            command = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace").strip()
+        except OSError:  # gone meanwhile, or another user's
+            continue
+        found.append(f"PID {entry.name} ({command[:80] or '?'})")
+    return found
+
+
+def _held(path: Path, waited: float) -> StoreError:
+    """A store another connection keeps locked (a reader's unfinished read transaction in rollback mode: a
+    notebook's unconsumed cursor), naming who holds it when that can be found."""
+    holders = _holders(path)
+    who = (f"held open by {', '.join(holders[:3])}" if holders else "held by another connection (of this process, "
+           "or of a process this user cannot inspect)")
+    return StoreError(f"store: {path} is locked by a reader that has not finished reading ({who}); waited {waited:g} s "
+                      "— finish that read (fetch all rows, close the cursor or the connection), or close that "
+                      "process, then run again (a live campaign's store may be read at any time: it is in WAL mode)")
+
+
 def _configure(path: Path, db: sqlite3.Connection, read_only: bool) -> None:
-    """The busy timeout and, for a writer, WAL journal mode (until :meth:`CampaignStore.close`)."""
-    try:
-        if not read_only:
-            db.execute("PRAGMA busy_timeout = 2000")  # a reader in rollback mode holds the switch: not for long
-            db.execute("PRAGMA journal_mode = WAL").fetchall()
-    except sqlite3.OperationalError:  # held by another process, or not writable: the store keeps its journal mode
-        pass  # (a write that then fails raises a StoreError naming the file and what was being written)
+    """The busy timeout and, for a writer, WAL journal mode (until :meth:`CampaignStore.close`).
+
+    Switching a closed store (rollback journal) to WAL needs every reader gone: a reader holding a read
+    transaction is waited for up to :data:`BUSY_TIMEOUT` s, then the open fails with a :class:`StoreError` naming
+    the processes that have the file open — not a failure at the first write of a resumed campaign."""
     db.execute(f"PRAGMA busy_timeout = {int(BUSY_TIMEOUT * 1000)}")
+    if read_only:
+        return
+    try:
+        db.execute("PRAGMA journal_mode = WAL").fetchall()
+    except sqlite3.OperationalError as exc:
+        if getattr(exc, "sqlite_errorname", "").startswith(("SQLITE_BUSY", "SQLITE_LOCKED")):
+            raise _held(path, BUSY_TIMEOUT) from None
+        # not writable: the store keeps its journal mode (a write then fails naming the file and what was written)
 
 
 def config_hash(config: Mapping[str, Any]) -> str:

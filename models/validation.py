@@ -163,22 +163,35 @@ def frequencies_arg(omega: object = None, frequencies_hz: object = None, omega_r
 _COUNT_WORDS = {2: "two", 3: "three", 4: "four"}
 
 
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
 def read_number_table(path: str | Path, columns: tuple[str, ...]) -> tuple[np.ndarray, list[int]]:
     """The rows of a CSV file of numbers, ``(values (rows, len(columns)), 1-based file row of each)``.
 
-    A first row that does not parse as numbers is a header; blank rows and empty cells are skipped.
+    The file is UTF-8 text (a leading byte-order mark, as spreadsheets write, is not part of the first cell).  A
+    first row none of whose cells parses as a number is a header; blank rows and empty cells are skipped.
 
     Raises
     ------
     ValueError
-        ``path: cannot read ...``, or naming the file and the row: a cell that is not a number, a wrong
-        number of columns (``columns`` names them, with units), a non-finite value; fewer than two data rows.
+        ``path: cannot read ...``; ``<file>: not UTF-8 text ...``; or naming the file and the row: a cell that is
+        not a number (a first row with some numbers is data, not a header), a wrong number of columns
+        (``columns`` names them, with units), a non-finite value; fewer than two data rows.
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = p.read_bytes().decode("utf-8-sig")
     except OSError as exc:
         raise ValueError(f"path: cannot read {str(p)!r}: {exc.strerror}") from exc
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{p}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at offset {exc.start}); save it as "
+                         f"UTF-8 (or plain ASCII) comma-separated values: {', '.join(columns)}") from None
     n = len(columns)
     data: list[list[float]] = []
     rows: list[int] = []
@@ -189,7 +202,7 @@ def read_number_table(path: str | Path, columns: tuple[str, ...]) -> tuple[np.nd
         try:
             vals = [float(c) for c in cells]
         except ValueError:
-            if i == 1:
+            if i == 1 and not any(_is_number(c) for c in cells):
                 continue  # header
             raise ValueError(f"{p}: row {i}: not {_COUNT_WORDS.get(n, n)} numbers: {row!r}") from None
         if len(vals) != n:

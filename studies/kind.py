@@ -42,6 +42,7 @@ class StudyContext:
     retry_failed: bool = False  # --resume also re-runs the starts stored as worker_lost
     show_progress: bool = True
     executed_on: list[str] = field(default_factory=list)  # what dask_context opened: "serial", a cluster, an address
+    clusters: list[Any] = field(default_factory=list)  # the ClusterRecord of each cluster used (workers, losses)
 
 
 class StudyResult(Protocol):
@@ -85,7 +86,7 @@ def discover_kinds() -> dict[str, StudyKind]:
 
 def dask_context(context: StudyContext):
     """The dask client for a study run (``None`` = serial when ``workers == 0``)."""
-    from railopt.design.parallel import dask_client
+    from railopt.design.parallel import cluster_record, dask_client
 
     @contextmanager
     def recorded():
@@ -93,6 +94,9 @@ def dask_context(context: StudyContext):
             where = "serial" if client is None else _where(client)
             if where not in context.executed_on:
                 context.executed_on.append(where)
+            record = cluster_record(client)
+            if record is not None:
+                context.clusters.append(record)  # filled in as the run goes: workers at the end, lost workers
             yield client
 
     return recorded()

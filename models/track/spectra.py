@@ -256,9 +256,10 @@ def erri_spectrum(level: str, component: str) -> RationalSpectrum:
 def read_spectrum_table(path: str | Path) -> TabulatedSpectrum:
     """A measured spectrum from a CSV file: two columns, wavenumber (rad/m) and PSD (m²/(rad/m)).
 
-    A first row that does not parse as numbers is taken as a header.  Errors name the file and the
+    UTF-8 text (with or without the byte-order mark spreadsheets write); a first row none of whose cells parses
+    as a number is taken as a header.  Errors name the file: a file that is not UTF-8 text, and with the
     (1-based) row: fewer than two data rows, a non-numeric or non-finite cell, a non-positive wavenumber
-    or PSD, wavenumbers not strictly increasing.
+    or PSD, wavenumbers not strictly increasing (:func:`railopt.models.validation.read_number_table`).
     """
     table, rows = read_number_table(path, ("wavenumber rad/m", "PSD m²/(rad/m)"))
     p = Path(path)
