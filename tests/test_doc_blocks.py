@@ -153,7 +153,9 @@ def test_python_blocks_run(page, tmp_path):
     text, where = script(page)
     files(page, tmp_path)
     (tmp_path / "doc_script.py").write_text(text)
-    env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONWARNINGS": "ignore::DeprecationWarning"}
+    (tmp_path / "tmp").mkdir()  # temporary folders the blocks make (run_study's default results root) land here
+    env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONWARNINGS": "ignore::DeprecationWarning",
+           "TMPDIR": str(tmp_path / "tmp")}
     done = subprocess.run([sys.executable, "doc_script.py"], cwd=tmp_path, capture_output=True, text=True,
                           timeout=SCRIPT_TIMEOUT_S, env=env)
     assert done.returncode == 0, f"{_rel(page)}: a python block fails\n{_doc_lines(done.stderr, where)[-4000:]}"
@@ -192,6 +194,8 @@ def _railopt(where: str, args: list[str], cwd: Path, produced: set[Path]) -> Non
             code = main(list(args))
         assert code == 0, f"{where}: `railopt {' '.join(args)}` exits {code}: {err.getvalue()[-2000:]}"
         assert out.getvalue().strip(), f"{where}: `railopt {' '.join(args)}` printed nothing"
+        if command == "list":  # a bundled study that does not load is listed as kind "?"
+            assert "| ? |" not in out.getvalue(), f"{where}: `railopt list` lists an invalid study:\n{out.getvalue()}"
         return
     assert command in ("run", "bench", "reference"), f"{where}: unknown railopt command {args}"
     err = io.StringIO()
@@ -228,6 +232,8 @@ def _setup_command(where: str, argv: list[str], cwd: Path, produced: set[Path]) 
         for name in argv[1:]:
             path = (cwd / name).resolve()
             made = any(path == p or p in path.parents for p in produced)
+            if produced:  # after a `railopt run` on the line: what that run wrote, not a committed reference file
+                assert made, f"{where}: cat {name}: not in what the `railopt run` before it writes ({sorted(produced)})"
             assert made or path.exists(), f"{where}: cat {name}: no such file, and no `railopt run` before writes it"
         return
     pytest.fail(f"{where}: `{' '.join(argv)}`: a command this test does not know; make it a railopt command or "
@@ -240,10 +246,13 @@ def test_bash_commands(page, tmp_path):
     if any(b.marker == "file" for b in blocks(page)):  # a tutorial: its files in a folder of their own
         files(page, tmp_path)
         cwd = tmp_path
-    produced: set[Path] = set()
+    produced: set[Path] = set()  # what the `railopt run` commands of the current line write
     found = commands(page)
     assert found, f"{_rel(page)}: bash blocks without a command"
+    line = None
     for where, argv in found:
+        if where != line:
+            line, produced = where, set()
         if _program(argv[0]) == "railopt":
             _railopt(where, argv[1:], cwd, produced)
         else:
