@@ -2,9 +2,11 @@
 
 Every error is one line naming the file and the offending field once: ``"<file>: <field.path>: <what is wrong>
 (got <value>)"`` (``railopt: error:`` in front on the command line).  The config tables of every kind derive from
-:class:`StrictModel` (unknown keys are errors; strings are never numbers; integers must fit their field) or
-:class:`FiniteModel` (NaN and inf refused too); intervals and bands are :data:`Interval` and :data:`BandHz`; a method
-name is a :data:`MethodName`, validated against the design layer's registry.  Relative paths in a study
+:class:`StrictModel`: unknown keys are errors with a did-you-mean, strings are never numbers, every number is
+finite (NaN and inf are refused naming the field) and integers must fit their field; intervals and bands are
+:data:`Interval` and :data:`BandHz`; a method name is a :data:`MethodName`, validated against the design layer's
+registry; a name that becomes a file or folder name (the study's, a model label, a trade-off's) is a
+:data:`FileName`.  Relative paths in a study
 (``vehicle = "car.toml"`` in ``[[models]].options``) are resolved from the study file's folder
 (:func:`resolve_paths`).  :mod:`railopt.studies.reference` writes ``docs/config-reference.md`` from the config
 models.
@@ -16,11 +18,22 @@ import math
 import re
 import types
 import typing
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+)
 
+from railopt.models.vehicle.schema import did_you_mean
 from railopt.studies.kind import StudyKind, discover_kinds
 from railopt.tomlfile import read_toml as _read_toml
 
@@ -29,7 +42,9 @@ __all__ = [
     "INT_LIMITS",
     "PATH_OPTIONS",
     "BandHz",
+    "NAME_MAX",
     "ConfigError",
+    "FileName",
     "FiniteModel",
     "Interval",
     "MethodName",
@@ -37,6 +52,7 @@ __all__ = [
     "StudyHeader",
     "field_errors",
     "load_study",
+    "not_one_of",
     "read_toml",
     "registered_method",
     "resolve_paths",
@@ -67,21 +83,104 @@ def _dedupe(text: str) -> str:
     return ": ".join(out)
 
 
-def field_errors(exc: Exception, prefix: str = "") -> str:
+def _shown(value: Any) -> str:
+    """``repr(value)``, or its length when it is long (a 300-character name is not repeated in the error)."""
+    text = repr(value)
+    if len(text) <= 80:
+        return text
+    return f"a string of {len(value)} characters" if isinstance(value, str) else text[:77] + "..."
+
+
+def _step(annotation: Any, part: str | int) -> Any:
+    """The annotation one location ``part`` below ``annotation`` (a field of a model, an item of a list or
+    table); None when it cannot be followed."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return _step(typing.get_args(annotation)[0], part)
+    if origin in (typing.Union, types.UnionType):
+        for arg in typing.get_args(annotation):
+            found = _step(arg, part)
+            if found is not None:
+                return found
+        return None
+    if isinstance(part, int) and origin in (list, tuple):
+        args = [a for a in typing.get_args(annotation) if a is not Ellipsis]
+        return args[min(part, len(args) - 1)] if args else None
+    if origin is dict:
+        args = typing.get_args(annotation)
+        return args[1] if len(args) == 2 else None
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel) and isinstance(part, str):
+        field = annotation.model_fields.get(part)
+        return None if field is None else field.annotation
+    return None
+
+
+def _table_keys(model: type[BaseModel] | None, loc: tuple) -> list[str]:
+    """The keys the table at ``loc`` inside ``model`` accepts ([] when unknown)."""
+    annotation: Any = model
+    for part in loc:
+        annotation = _step(annotation, part)
+    while typing.get_origin(annotation) in (Annotated, typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(annotation) if isinstance(a, type) and issubclass(a, BaseModel)]
+        annotation = args[0] if args else typing.get_args(annotation)[0]
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return list(annotation.model_fields)
+    return []
+
+
+def _unknown_key(loc: tuple, prefix: str, model: type[BaseModel] | None) -> str:
+    key, table = str(loc[-1]), loc[:-1]
+    keys = _table_keys(model, table)
+    hint = did_you_mean(key, keys) or (f"; keys are {keys}" if keys else "")
+    where = ".".join(p for p in (prefix, ".".join(str(x) for x in loc)) if p)
+    what = "unknown table or key at the top level" if not table and not prefix else "unknown key"
+    return _dedupe(f"{where}: {what}{hint}")
+
+
+def _own_key(loc: str, at: tuple, msg: str, model: type[BaseModel] | None) -> tuple[str, str]:
+    """``("design", "options.xtol: bad")`` → ``("design.options.xtol", "bad")``: a message of a table's validator
+    that starts with one of that table's own keys names the field by its dotted path."""
+    head, sep, rest = msg.partition(": ")
+    if sep and _is_path(head) and re.split(r"[.\[]", head)[0] in _table_keys(model, at):
+        return f"{loc}.{head}", rest
+    return loc, msg
+
+
+def field_errors(exc: Exception, prefix: str = "", model: type[BaseModel] | None = None) -> str:
     """Join a pydantic ``ValidationError`` (or any error) into one line naming each field once.
 
     ``"<field.path>: <what is wrong> (got <value>)"``; an error of the whole file has no path in front, and a
-    message that starts with its own field's path (or a longer one) does not repeat it."""
+    message that starts with its own field's path (or a longer one) does not repeat it.  With ``model`` (the
+    config model validated), an unknown key gets a did-you-mean among the keys of its table."""
     if not isinstance(exc, ValidationError):
-        return _dedupe(f"{prefix}: {exc}" if prefix else str(exc))
+        if not prefix:
+            return _dedupe(str(exc))
+        loc, msg = _own_key(prefix, (), str(exc), model)
+        return _dedupe(f"{loc}: {msg}")
     lines = []
     for err in exc.errors():
+        if err["type"] == "extra_forbidden":
+            lines.append(_unknown_key(tuple(err["loc"]), prefix, model))
+            continue
         loc = ".".join(p for p in (prefix, ".".join(str(x) for x in err["loc"])) if p)
         msg = err["msg"].removeprefix("Value error, ")
+        if err["loc"]:
+            loc, msg = _own_key(loc, tuple(err["loc"]), msg, model)
         got = err.get("input")
-        got_text = "" if isinstance(got, dict | list | tuple) or err["type"] == "value_error" else f" (got {got!r})"
+        got_text = ("" if isinstance(got, dict | list | tuple) or err["type"] == "value_error"
+                    else f" (got {_shown(got)})")
         lines.append(_dedupe(f"{loc}: {msg}{got_text}" if loc else f"{msg}{got_text}"))
     return "; ".join(lines)
+
+
+def not_one_of(name: str, choices: Sequence[str], what: str, listed: int = 12) -> str:
+    """``"unknown parameter 'K2x'; did you mean 'K2'?"``: an unknown name with the closest choice; without a close
+    one the choices are listed when there are at most ``listed`` of them, else only counted (no 70-name dump)."""
+    hint = did_you_mean(name, choices)
+    if not hint:
+        hint = (f"; known: {list(choices)}" if len(choices) <= listed
+                else f"; none of the {len(choices)} known names is close")
+    return f"unknown {what} {name!r}{hint}"
 
 
 # ---------------------------------------------------------------------------------------------- shared bases
@@ -113,7 +212,7 @@ def registered_method(name: str) -> str:
     from railopt.design import METHODS
 
     if name not in METHODS:
-        raise ValueError(f"unknown method {name!r}; registered: {sorted(METHODS)}")
+        raise ValueError(not_one_of(name, sorted(METHODS), "method"))
     return name
 
 
@@ -172,13 +271,42 @@ def _check_value(annotation: Any, value: Any, name: str, where: str = "") -> Any
     return value
 
 
+NAME_MAX = 100
+"""The longest name (characters) that becomes part of a file or folder name: the study's name, model labels,
+trade-off and case labels; the file names made from them stay far below the file system's 255 bytes."""
+
+_NAME_CHARS = re.compile(r"[A-Za-z0-9_.\-]")
+
+
+def _file_name(value: Any) -> Any:
+    if not isinstance(value, str):
+        return value  # the type check names it
+    if not value:
+        raise ValueError("must not be empty (it names files of the results)")
+    if len(value) > NAME_MAX:
+        raise ValueError(f"too long for a file name: {len(value)} characters, at most {NAME_MAX}")
+    bad = sorted({c for c in value if not _NAME_CHARS.fullmatch(c)})
+    if bad:
+        raise ValueError(f"{''.join(bad)!r} cannot be part of a file name: use letters, digits, '_', '-' and '.' "
+                         f"(got {_shown(value)})")
+    if set(value) == {"."}:
+        raise ValueError(f"{value!r} is not a file name")
+    return value
+
+
+FileName = Annotated[str, BeforeValidator(_file_name), Field(max_length=NAME_MAX, pattern=r"^[A-Za-z0-9_.\-]+$")]
+"""A name that becomes (part of) a file name: letters, digits, ``_``, ``-`` and ``.``, 1 to :data:`NAME_MAX`
+characters; refused on validation naming the field, never after the work when the file is written."""
+
+
 class StrictModel(BaseModel):
-    """Base for config tables: unknown keys and wrong types are errors that name the field.
+    """Base for config tables: unknown keys, wrong types and non-finite numbers are errors that name the field.
 
     Strict: a string is never read as a number (``lower = "1e5"`` is refused), nor ``true`` or ``16.0`` as a
-    count; an integer must fit its field (:data:`INT_LIMITS`; int64 at most).  TOML arrays are taken as tuples."""
+    count; every float is finite (``xtol = inf`` and NaN are refused, in nested arrays and tables too); an integer
+    must fit its field (:data:`INT_LIMITS`; int64 at most).  TOML arrays are taken as tuples."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
     @field_validator("*", mode="before")
     @classmethod
@@ -188,15 +316,14 @@ class StrictModel(BaseModel):
 
 
 class FiniteModel(StrictModel):
-    """A config table whose floats must be finite (NaN and inf are refused naming the field)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+    """A config table whose floats must be finite: every :class:`StrictModel` now (kept as the name the kinds
+    use)."""
 
 
 class StudyHeader(StrictModel):
     """The ``[study]`` table of every study file."""
 
-    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
+    name: FileName = Field(pattern=r"^[A-Za-z0-9_\-]+$", description="the results folder's name")
     kind: str
     description: str = ""
 
@@ -206,7 +333,7 @@ def study_kind(name: str) -> StudyKind:
     """The registered kind called ``name`` (every kind module is imported first)."""
     kinds = discover_kinds()
     if name not in kinds:
-        raise ConfigError(f"study.kind: unknown kind {name!r}; known kinds: {sorted(kinds)}")
+        raise ConfigError(f"study.kind: {not_one_of(name, sorted(kinds), 'kind')}")
     return kinds[name]
 
 
@@ -274,5 +401,5 @@ def load_study(path: str | Path) -> tuple[StudyKind, BaseModel, dict[str, Any]]:
     try:
         config = kind.config_model.model_validate(raw)
     except (ValidationError, ValueError) as exc:  # model validators may raise plain ValueError
-        raise ConfigError(f"{path}: {field_errors(exc)}") from None
+        raise ConfigError(f"{path}: {field_errors(exc, model=kind.config_model)}") from None
     return kind, config, raw

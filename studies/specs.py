@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Literal
 
-from pydantic import Field, model_validator
+import numpy as np
+from pydantic import Field, field_validator, model_validator
 
 from railopt.design import DesignVariable
 from railopt.studies.config import BandHz, FiniteModel, MethodName, StrictModel
@@ -49,6 +50,20 @@ class CampaignSettings(StrictModel):
     def solver_options(self) -> dict[str, Any]:
         """The solver options as keyword arguments of the design layer."""
         return self.options.model_dump()
+
+    def solver_methods(self) -> list[str]:
+        """The methods a run solves with: ``method``."""
+        return [self.method]
+
+    @model_validator(mode="after")
+    def _options_of_each_method(self) -> CampaignSettings:
+        """The design layer's own check of the options (:func:`railopt.design.solve.method_options`) for every
+        method a run solves with: what a run would refuse, refused here naming ``options.<key>``."""
+        from railopt.design.solve import method_options
+
+        for method in self.solver_methods():
+            method_options(method, self.solver_options())
+        return self
 
 
 class VariableSpec(FiniteModel):
@@ -156,8 +171,48 @@ class StabilitySpec(FiniteModel):
     zeta_min: float | None = Field(None, ge=0, lt=1)
     required_speed_m_s: float | None = Field(None, gt=0, lt=1000)
     tracks: list[Literal["rigid", "flexible"]] = Field(default_factory=list)
-    exclude: list[str] = Field(default_factory=list, description="mode names (or name prefixes) left out")
+    exclude: list[str] = Field(default_factory=list, description="mode names (or name prefixes) left out; each "
+                               "must name a mode of the model")
+
+    @field_validator("tracks", "exclude")
+    @classmethod
+    def _unique(cls, v: list[str]) -> list[str]:
+        repeated = sorted({x for x in v if v.count(x) > 1})
+        if repeated:
+            raise ValueError(f"entries must be unique, repeated {repeated}")
+        return v
+
+    @field_validator("exclude")
+    @classmethod
+    def _named(cls, v: list[str]) -> list[str]:
+        for i, name in enumerate(v):
+            if not name.strip():
+                raise ValueError(f"entry {i} ({name!r}) is empty: an empty name is a prefix of every mode name and "
+                                 "would leave every root out of the constraint; name a mode, e.g. 'body hunting'")
+        return v
+
+    @model_validator(mode="after")
+    def _rows(self) -> StabilitySpec:
+        if self.lowest_speed_m_s is not None and self.speeds == 1:
+            raise ValueError("lowest_speed_m_s: with speeds = 1 the one row is at the lowest speed and the required "
+                             "speed is never checked; give speeds ≥ 2 or leave lowest_speed_m_s out")
+        if self.lowest_speed_m_s is not None and self.required_speed_m_s is not None:
+            self.check_lowest(self.required_speed_m_s, "required_speed_m_s")
+        return self
+
+    def check_lowest(self, required: float, what: str, prefix: str = "") -> None:
+        """Refuse a ``lowest_speed_m_s`` at or above the ``required`` speed (m/s): the rows would collapse onto one
+        speed.  ValueError naming ``<prefix>lowest_speed_m_s`` and ``what`` the required speed is."""
+        if self.lowest_speed_m_s is not None and not self.lowest_speed_m_s < required:
+            raise ValueError(f"{prefix}lowest_speed_m_s: {self.lowest_speed_m_s:g} m/s is not below the required speed "
+                             f"{required:g} m/s ({what}): the {self.speeds} rows would collapse onto one speed")
 
     def required(self, setup: ModelSetup) -> float:
         """The required speed (m/s): ``required_speed_m_s``, or the model's maximum operating speed."""
         return self.required_speed_m_s or setup.required_speed
+
+    def grid(self, required: float) -> tuple[float, ...]:
+        """The rows' speeds (m/s), ``speeds`` of them evenly spaced from ``lowest_speed_m_s`` (default ``required /
+        speeds``) to ``required``."""
+        low = min(self.lowest_speed_m_s or required / self.speeds, required)
+        return tuple(float(v) for v in np.linspace(low, required, self.speeds))

@@ -23,7 +23,7 @@ from pydantic import AfterValidator, BaseModel, Field, PrivateAttr, model_valida
 
 from railopt.studies.catalog.checks import AbscissaCheck, Check, CheckResult, HuntingCheck, _values  # noqa: F401
 from railopt.studies.catalog.setup import UNITS, ModelSetup, ParameterMap, Transform
-from railopt.studies.config import Interval, StrictModel, StudyHeader, field_errors
+from railopt.studies.config import FileName, Interval, StrictModel, StudyHeader, field_errors, not_one_of
 
 __all__ = [
     "MODELS",
@@ -45,7 +45,7 @@ __all__ = [
     "require_unique",
 ]
 
-NOT_MODELS = frozenset({"checks", "setup"})
+NOT_MODELS = frozenset({"checks", "setup", "views"})
 """Modules of this package that hold the catalog's own machinery, not models: :func:`discover_models` skips them."""
 
 
@@ -100,14 +100,14 @@ def catalog_entry(name: str, field_name: str = "model") -> CatalogEntry:
     """The registered model ``name`` (models discovered first); ``ValueError`` naming ``field_name`` when unknown."""
     models = discover_models()
     if name not in models:
-        raise ValueError(f"{field_name}: unknown model {name!r}; known models: {sorted(models)}")
+        raise ValueError(f"{field_name}: {not_one_of(name, sorted(models), 'model')}")
     return models[name]
 
 
 class ModelRef(StrictModel):
     """``[[models]]`` entry of a study: a label, a registered model name and its options."""
 
-    label: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    label: FileName = Field(description="names the model's campaigns, stores and table rows (a file name)")
     model: str
     options: dict[str, Any] = Field(default_factory=dict)
 
@@ -117,7 +117,7 @@ class ModelRef(StrictModel):
         try:
             return entry.options.model_validate(self.options)
         except Exception as exc:  # pydantic.ValidationError: re-raise naming the config field
-            raise ValueError(field_errors(exc, f"{where}.options")) from None
+            raise ValueError(field_errors(exc, f"{where}.options", entry.options)) from None
 
     _built: dict[str, Any] = PrivateAttr(default_factory=dict)
 
@@ -143,8 +143,8 @@ class ModelRef(StrictModel):
             options = self.validated_options(where)  # its errors name the field already
             try:
                 return entry.build(options)
-            except ValueError as exc:
-                raise ValueError(f"{where}.options: {exc}") from None
+            except ValueError as exc:  # "view: ..." names models[i].options.view
+                raise ValueError(field_errors(exc, f"{where}.options", entry.options)) from None
 
         return self.built("setup", make)
 

@@ -16,7 +16,7 @@ from pydantic import Field
 from railopt.models.units import INCH, MPH
 from railopt.models.vehicle.cab import CabInput, cab_lateral_model
 from railopt.studies.catalog import ModelSetup, PositiveInterval, register_model
-from railopt.studies.catalog.vehicle import load, vehicle_setup
+from railopt.studies.catalog.vehicle import VEHICLE, load, vehicle_setup
 from railopt.studies.config import StrictModel
 
 __all__ = ["CabOptions", "cab_lateral_setup"]
@@ -28,10 +28,14 @@ class CabOptions(StrictModel):
     ``amplitude_in`` is the lateral irregularity (in); the band runs to ``max_frequency_hz``, reached at
     ``max_speed_mph`` (``fixed_wavelength``: λ = S_max / f_max, every frequency at its own speed) or with the speed
     fixed at ``max_speed_mph`` (``fixed_speed``).  ``max_operating_speed_mph`` and ``critical_search_mph`` set the
-    hunting check; ``parameters`` override values of the vehicle file.
+    hunting check; ``view = "full"`` builds its stability families of every coordinate (an asymmetric vehicle);
+    ``parameters`` override values of the vehicle file.
     """
 
-    vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
+    vehicle: str = Field(description=VEHICLE)
+    view: Literal["lateral", "full"] = Field(
+        "lateral", description="view of the stability families (hunting check, root loci, stability rows): full for "
+                               "a vehicle not symmetric about its centre line")
     amplitude_in: float = Field(0.25, gt=0, lt=100, allow_inf_nan=False, description="lateral irregularity, in")
     max_frequency_hz: float = Field(3.0, gt=0, lt=1000, allow_inf_nan=False)
     max_speed_mph: float = Field(150.0, gt=0, lt=1000, allow_inf_nan=False, description="speed at max_frequency_hz")
@@ -64,7 +68,7 @@ def cab_lateral_setup(options: CabOptions) -> ModelSetup:
         description = f"{vehicle.name} cab model, S = {options.max_speed_mph:g} mph"
     search = (options.critical_search_mph[0] * MPH, options.critical_search_mph[1] * MPH)
     setup = vehicle_setup(vehicle, family, description, ("rigid", "flexible"), search,
-                          options.max_operating_speed_mph * MPH, abscissa=family)
+                          options.max_operating_speed_mph * MPH, abscissa=family, view=options.view)
     suffix = {"displacement": "", "velocity": "/s", "acceleration": "/s²"}
     system = family.at()
     setup.units = {o: ("rad" if o == "body_roll" else "m") + suffix[system.outputs[o].quantity]

@@ -12,6 +12,7 @@ import numpy as np
 
 from railopt.models import ParametricSystem
 from railopt.studies.catalog.checks import Check, _values
+from railopt.studies.config import not_one_of
 
 __all__ = ["UNITS", "ModelSetup", "ParameterMap", "Transform"]
 
@@ -70,9 +71,18 @@ class ParameterMap:
         label = name if key == name else f"{name} ({key})"
         raise ValueError(f"{where}.lower: {label} is a {what} and cannot be below {least:g}; got {lower:g}")
 
-    def check_variables(self, variables: Sequence[Any], where: str = "design.variables") -> None:
-        """:meth:`check_bounds` of each variable (objects with ``name``, ``lower``, ``upper``), naming
-        ``<where>[i].lower``."""
+    def check_names(self, names: Sequence[str], where: str, model: str = "the model") -> None:
+        """Refuse a name that is not designable: ``ValueError`` ``"<where>[i].name: <model>: unknown parameter
+        'K2x'; did you mean 'K2'?"`` (the closest name, never the whole list of a vehicle's parameters)."""
+        for i, name in enumerate(names):
+            if name not in self.designable:
+                raise ValueError(f"{where}[{i}].name: {model}: {not_one_of(name, self.designable, 'parameter')}")
+
+    def check_variables(self, variables: Sequence[Any], where: str = "design.variables", model: str = "the model"
+                        ) -> None:
+        """:meth:`check_names` of the variables (objects with ``name``, ``lower``, ``upper``), then
+        :meth:`check_bounds` of each, naming ``<where>[i].name`` or ``<where>[i].lower``."""
+        self.check_names([v.name for v in variables], where, model)
         for i, v in enumerate(variables):
             self.check_bounds(v.name, v.lower, v.upper, f"{where}[{i}]")
 
@@ -122,6 +132,9 @@ class ModelSetup:
     stability : mapping track -> ParametricSystem
         The vehicle's unforced lateral family on each track (speed term included), its parameters named
         as the family's (a subset of them): root loci and hunting checks.  Empty without forward speed.
+    other_tracks : mapping track -> ParametricSystem
+        The same family on the vehicle's other tracks: not checked by default, but a study's ``[stability]
+        tracks`` may constrain them (a rigid-track ride model required not to hunt on flexible track too).
     required_speed : float or None
         The speed (m/s) up to which a design must not hunt (the hunting check's maximum operating speed).
     limits : mapping name -> float
@@ -141,6 +154,7 @@ class ModelSetup:
     named_designs: dict[str, dict[str, float]] = field(default_factory=dict)
     checks: dict[str, Check] = field(default_factory=dict)
     stability: dict[str, ParametricSystem] = field(default_factory=dict)
+    other_tracks: dict[str, ParametricSystem] = field(default_factory=dict)
     description: str = ""
     required_speed: float | None = None
     limits: dict[str, float] = field(default_factory=dict)

@@ -2,8 +2,9 @@
 
 Both are built by :func:`vehicle_setup`, the one path from a vehicle and a family to a
 :class:`~railopt.studies.catalog.ModelSetup`: every suspension element designable by id (or alias), the
-file's values as the existing design, the unforced lateral family on each track for stability, and the
-checks ``spectral_abscissa`` (at the model's speed) and ``hunting`` (:class:`HuntingCheck`).
+file's values as the existing design, the unforced lateral family on each track for stability (the full family
+for a ``view = "full"`` model: an asymmetric vehicle), and the checks ``spectral_abscissa`` (at the model's
+speed) and ``hunting`` (:class:`HuntingCheck`).  ``vehicle`` is required: no model runs a vehicle nobody named.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pydantic import Field
 
 from railopt.models import ParametricSystem
 from railopt.models.vehicle import load_vehicle
+from railopt.models.vehicle.assembly import TRACKS
 from railopt.models.vehicle.outputs import UNIT_SUFFIX, output_rows
 from railopt.studies.catalog import (
     AbscissaCheck,
@@ -24,13 +26,19 @@ from railopt.studies.catalog import (
     PositiveInterval,
     register_model,
 )
+from railopt.studies.catalog.views import stability_view, vehicle_view
 from railopt.studies.config import StrictModel
 
 __all__ = [
-    "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family", "load",
-    "physical_limits", "readable_aliases", "vehicle_forced_model", "vehicle_forced_setup", "vehicle_lateral_setup",
-    "vehicle_setup",
+    "VEHICLE", "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family",
+    "load", "physical_limits", "readable_aliases", "tracks_of", "vehicle_forced_model", "vehicle_forced_setup",
+    "vehicle_lateral_setup", "vehicle_setup",
 ]
+
+VEHICLE = ("a bundled vehicle name (sd40-2, manchester-coach, single-wheelset) or a vehicle file path (relative "
+           "to the study file); required")
+"""The description of the ``vehicle`` option of every vehicle model: required (a forgotten key never runs some
+default vehicle)."""
 
 
 def load(options):
@@ -39,10 +47,16 @@ def load(options):
     return vehicle.with_parameters(options.parameters) if options.parameters else vehicle
 
 
-def lateral_family(vehicle, track: str, names: Sequence[str]) -> ParametricSystem:
-    """The vehicle's unforced lateral family on ``track`` in those of ``names`` that act laterally."""
-    view = vehicle.lateral(track=track)
-    return view.family([n for n in names if n in view.parts or n in view.aliases])
+def lateral_family(vehicle, track: str, names: Sequence[str], view: str = "lateral") -> ParametricSystem:
+    """The vehicle's unforced lateral family on ``track`` in those of ``names`` that act laterally; with ``view =
+    "full"`` the family of every coordinate (an asymmetric vehicle's lateral motion couples to the vertical)."""
+    model = vehicle_view(vehicle, view, track)
+    return model.family([n for n in names if n in model.parts or n in model.aliases])
+
+
+def tracks_of(vehicle) -> tuple[str, ...]:
+    """The tracks the vehicle can run on: rigid, and flexible when its file has a ``[track]`` table."""
+    return tuple(t for t in TRACKS if t == "rigid" or vehicle.track is not None)
 
 
 PHYSICAL = {"spring": "stiffness", "damper": "damping coefficient", "rotational_spring": "rotational stiffness",
@@ -80,7 +94,7 @@ def readable_aliases(vehicle, names: Sequence[str]) -> dict[str, str]:
 
 def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: Sequence[str],
                   search: tuple[float, float], max_speed: float, abscissa: ParametricSystem | None = None,
-                  aliases: dict[str, str] | None = None) -> ModelSetup:
+                  aliases: dict[str, str] | None = None, view: str = "lateral") -> ModelSetup:
     """A vehicle model ready for a study.
 
     Parameters
@@ -104,10 +118,17 @@ def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: S
     aliases : mapping alias -> id, optional
         Readable names, designable and set in the existing design too; default: every alias of the vehicle
         (element aliases and the file's aliases) that names a parameter of ``family``.
+    view : {"lateral", "full"}
+        The view of the stability families: ``full`` for an asymmetric vehicle.
+
+    The families of the vehicle's other tracks (:func:`tracks_of`) are the setup's ``other_tracks``: a study's
+    ``[stability] tracks`` may constrain them too.
     """
     names = tuple(family.parameters)
     aliases = readable_aliases(vehicle, names) if aliases is None else dict(aliases)
-    stability = {track: lateral_family(vehicle, track, names) for track in tracks}
+    stability = {track: lateral_family(vehicle, track, names, view) for track in tracks}
+    other_tracks = {track: lateral_family(vehicle, track, names, view) for track in tracks_of(vehicle)
+                    if track not in stability}
     if abscissa is None:
         abscissa = stability[tracks[0]].with_values(stability[tracks[0]].values, speed=family.speed)
     existing = dict(zip(names, family.values, strict=True))
@@ -119,6 +140,7 @@ def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: S
         checks={"spectral_abscissa": AbscissaCheck(abscissa),
                 "hunting": HuntingCheck(stability, names, search, max_speed)},
         stability=stability,
+        other_tracks=other_tracks,
         description=description,
         required_speed=max_speed,
         limits=dict(vehicle.clearances.values),
@@ -140,12 +162,15 @@ class HuntingOptions(StrictModel):
 
 
 class VehicleOptions(HuntingOptions):
-    """Options of the ``vehicle_lateral`` model: vehicle file, track, forward speed (m/s), output row, overrides.
+    """Options of the ``vehicle_lateral`` model: vehicle file, view, track, forward speed (m/s), output row, overrides.
 
     With the hunting-check options of :class:`HuntingOptions`; ``output`` defaults to the first coordinate.
     """
 
-    vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
+    vehicle: str = Field(description=VEHICLE)
+    view: Literal["lateral", "full"] = Field(
+        "lateral", description="lateral: the (v, alpha, gamma) block of a symmetric vehicle; full: every coordinate "
+                               "(a vehicle not symmetric about its centre line: one-sided dampers, worn wheels)")
     track: Literal["rigid", "flexible"] = "rigid"
     speed_m_s: float = Field(30.0, gt=0, lt=1000, allow_inf_nan=False, description="forward speed of `system`")
     output: str | None = Field(None, description="output row of the model (e.g. cab.lateral)")
@@ -157,10 +182,10 @@ class VehicleOptions(HuntingOptions):
 def vehicle_lateral_setup(options: VehicleOptions) -> ModelSetup:
     """The lateral model of a vehicle file; every suspension element is designable by id or alias."""
     vehicle = load(options)
-    model = vehicle.lateral(track=options.track, speed=options.speed_m_s)
+    model = vehicle_view(vehicle, options.view, options.track, options.speed_m_s)
     family = model.family(list(model.parts), outputs=[options.output or model.coordinates[0]])
-    return vehicle_setup(vehicle, family, f"{vehicle.name}, lateral, {options.track} track", [options.track],
-                         *options.hunting(options.speed_m_s))
+    return vehicle_setup(vehicle, family, f"{vehicle.name}, {options.view}, {options.track} track", [options.track],
+                         *options.hunting(options.speed_m_s), view=stability_view(options.view))
 
 
 # ---------------------------------------------------------------------------------------------- forced response
@@ -175,15 +200,17 @@ class IrregularityOptions(StrictModel):
 class VehicleForcedOptions(HuntingOptions):
     """Options of the ``vehicle_forced`` model: a vehicle view forced by a sinusoidal rail irregularity.
 
-    ``view`` vertical or lateral, on rigid or flexible ``track`` at ``speed_m_s`` (m/s); ``input`` the irregularity
+    ``view`` vertical, lateral or full (every coordinate: a vehicle not symmetric about its centre line), on rigid
+    or flexible ``track`` at ``speed_m_s`` (m/s); ``input`` the irregularity
     (kind, amplitude per rail in m, rail phasing); ``outputs`` coordinates, named rows or body points, as
     ``quantity`` (displacement, velocity or acceleration); ``parameters`` override values of the vehicle file.
     """
 
-    vehicle: str = Field("sd40-2", description="a bundled vehicle name or a vehicle file path")
+    vehicle: str = Field(description=VEHICLE)
     track: Literal["rigid", "flexible"] = "rigid"
     speed_m_s: float = Field(30.0, gt=0, lt=1000, allow_inf_nan=False, description="forward speed S, m/s")
-    view: Literal["vertical", "lateral"] = "vertical"
+    view: Literal["vertical", "lateral", "full"] = Field(
+        "vertical", description="full: every coordinate (a vehicle not symmetric about its centre line)")
     input: IrregularityOptions = Field(default_factory=IrregularityOptions)
     outputs: list[str] = Field(default_factory=lambda: ["body.w"], min_length=1,
                                description="coordinates, named rows or body points '<body>[x,y,z].<x|y|z>'")
@@ -196,8 +223,7 @@ def vehicle_forced_model(options: VehicleForcedOptions):
     from railopt.models.vehicle.irregularity import Irregularity
 
     vehicle = load(options)
-    view = vehicle.vertical if options.view == "vertical" else vehicle.lateral
-    model = view(track=options.track, speed=options.speed_m_s)
+    model = vehicle_view(vehicle, options.view, options.track, options.speed_m_s)
     try:
         irregularity = Irregularity(options.input.kind, options.input.amplitude_m, options.input.rails)
     except ValueError as exc:
@@ -216,7 +242,7 @@ def vehicle_forced_setup(options: VehicleForcedOptions) -> ModelSetup:
     description = (f"{model.name}, {options.view}, {options.track} track, S = {options.speed_m_s:g} m/s, "
                    f"{irregularity.label}")
     setup = vehicle_setup(vehicle, family, description, [options.track], *options.hunting(options.speed_m_s),
-                          abscissa=model.family(names))
+                          abscissa=model.family(names), view=stability_view(options.view))
     setup.units = {r.name: r.unit + UNIT_SUFFIX[options.quantity] for r in output_rows(model, options.outputs)}
     setup.input_label = f"{options.input.amplitude_m * 1000:.4g} mm {options.input.kind} irregularity"
     setup.input_amplitude_m = options.input.amplitude_m

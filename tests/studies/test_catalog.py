@@ -12,9 +12,9 @@ from railopt.studies.config import ConfigError, load_study
 from railopt.studies.output.writer import Writer
 
 VEHICLE_MODELS = {
-    "vehicle_lateral": {"track": "rigid"},
-    "vehicle_forced": {"view": "lateral", "input": {"kind": "alignment"}, "outputs": ["body.v"]},
-    "cab_lateral": {},
+    "vehicle_lateral": {"vehicle": "sd40-2", "track": "rigid"},
+    "vehicle_forced": {"vehicle": "sd40-2", "view": "lateral", "input": {"kind": "alignment"}, "outputs": ["body.v"]},
+    "cab_lateral": {"vehicle": "sd40-2"},
 }
 
 
@@ -46,7 +46,7 @@ def test_the_tmd_has_no_stability_family_and_a_typed_abscissa_check():
 
 def test_hunting_check_is_the_critical_speed_of_the_stability_family():
     setup = ModelRef(label="m", model="vehicle_lateral",
-                     options={"track": "rigid", "max_operating_speed_m_s": 20.0,
+                     options={"vehicle": "sd40-2", "track": "rigid", "max_operating_speed_m_s": 20.0,
                               "critical_search_m_s": [2.0, 80.0]}).setup()
     result = setup.checks["hunting"](setup.defaults)
     model = setup.stability_model(setup.defaults)
@@ -68,7 +68,7 @@ def test_hunting_check_states_the_study_criterion_and_fails_a_design_between_row
     """With a decay-rate margin, ``stable`` needs Re s ≤ −σ at every speed up to the required one (certified), not
     at grid speeds: a margin just above the design's largest Re s (from a dense scan) fails it."""
     setup = ModelRef(label="m", model="vehicle_lateral",
-                     options={"track": "rigid", "max_operating_speed_m_s": 30.0,
+                     options={"vehicle": "sd40-2", "track": "rigid", "max_operating_speed_m_s": 30.0,
                               "critical_search_m_s": [2.0, 80.0]}).setup()
     model = setup.stability_model(setup.defaults)
     def largest_real_part(S: float) -> float:
@@ -87,7 +87,7 @@ def test_hunting_check_states_the_study_criterion_and_fails_a_design_between_row
 
 
 def test_parameter_map_aliases_and_jacobian():
-    setup = ModelRef(label="m", model="cab_lateral").setup()
+    setup = ModelRef(label="m", model="cab_lateral", options={"vehicle": "sd40-2"}).setup()
     alias, element = next(iter(setup.parameter_map.aliases.items()))
     p, J = setup.parameters([alias], np.array([123.0]))
     k = list(setup.family.parameters).index(element)
@@ -102,7 +102,7 @@ def test_a_method_name_is_checked_against_the_design_registry(tmp_path):
     assert 'methods = ["slsqp"]' in text
     study = tmp_path / "bad.toml"
     study.write_text(text.replace('methods = ["slsqp"]', 'methods = ["newton"]'))
-    with pytest.raises(ConfigError, match=r"design.methods.0: .*unknown method 'newton'; registered: \["):
+    with pytest.raises(ConfigError, match=r"design.methods.0: .*unknown method 'newton'; known: \["):
         load_study(study)
 
 

@@ -91,7 +91,7 @@ def test_unknown_kind_and_missing_kind_name_the_file(tmp_path, capsys):
     path.write_text(path.read_text().replace('kind = "campaign"', 'kind = "campain"'))
     assert main(["validate", str(path)]) == 2
     assert one_error(capsys.readouterr().err).startswith(
-        f"railopt: error: {path}: study.kind: unknown kind 'campain'; known kinds: [")
+        f"railopt: error: {path}: study.kind: unknown kind 'campain'; did you mean 'campaign'?")
     path.write_text('[study]\nname = "x"\n')
     assert main(["validate", str(path)]) == 2
     assert one_error(capsys.readouterr().err) == (

@@ -13,7 +13,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from railopt.studies.catalog import ModelSetup, ModelsStudy, PositiveInterval, require_unique
-from railopt.studies.config import FiniteModel, MethodName, StrictModel
+from railopt.studies.config import FileName, FiniteModel, MethodName, StrictModel, not_one_of
 from railopt.studies.specs import (
     CampaignSettings,
     ConstraintSpec,
@@ -26,6 +26,7 @@ from railopt.studies.specs import (
 )
 
 __all__ = [
+    "FILE_NAME_BYTES",
     "CampaignDesign",
     "CampaignSettings",
     "CampaignStudyConfig",
@@ -39,7 +40,15 @@ __all__ = [
     "SurfaceSpec",
     "TradeoffSpec",
     "VariableSpec",
+    "campaign_label",
+    "model_tag",
+    "output_files",
+    "surface_stem",
+    "tradeoff_stem",
 ]
+
+FILE_NAME_BYTES = 255
+"""The longest file name (bytes, UTF-8) the file systems a study publishes to accept."""
 
 
 class CampaignDesign(CampaignSettings):
@@ -82,6 +91,10 @@ class CampaignDesign(CampaignSettings):
             raise ValueError(f"entries must be unique, got {v}")
         return v
 
+    def solver_methods(self) -> list[str]:
+        """Every method a campaign of this design runs: ``methods`` and ``constrained_methods``."""
+        return list(dict.fromkeys([*self.methods, *(self.constrained_methods or [])]))
+
 
 class ReportSpec(StrictModel):
     """``[report]``: the designs compared in the tables and figures, FRF points, figure resolution."""
@@ -102,7 +115,8 @@ class TradeoffSpec(FiniteModel):
     ``damping`` (the constrained problem with every vehicle mode at least ε damped, ζ_min = ε, up to the required
     speed: what each per cent of damping costs in U), or another check (value ≥ ε, derivative-free)."""
 
-    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
+    name: FileName = Field(pattern=r"^[A-Za-z0-9_\-]+$", description="names its files (tradeoff_<name>.csv, "
+                           "pareto_<name>.csv/.png): unique among the trade-offs")
     output: str | None = None
     check: str | None = None
     epsilons: list[float] = Field(min_length=2)
@@ -124,6 +138,12 @@ class TradeoffSpec(FiniteModel):
             raise ValueError(f"tradeoffs.{self.name}: give exactly one of output or check")
         if self.check not in (None, "hunting", "damping") and self.method != "cobyla":
             raise ValueError(f"tradeoffs.{self.name}.method: a check is not differentiable; use method = 'cobyla'")
+        if self.check == "damping" and max(self.epsilons) >= 1:
+            raise ValueError(f"epsilons: a 'damping' trade-off's targets are damping ratios below 1, got "
+                             f"{max(self.epsilons)}")
+        if self.check == "hunting" and max(self.epsilons) >= 1000:
+            raise ValueError(f"epsilons: a 'hunting' trade-off's targets are required speeds below 1000 m/s, got "
+                             f"{max(self.epsilons)}")
         return self
 
 
@@ -152,6 +172,8 @@ class CampaignStudyConfig(ModelsStudy):
     def _resolve(self) -> CampaignStudyConfig:
         """Everything a run would reject is rejected here (``railopt validate`` = ``run``)."""
         require_unique("design.variables", [v.name for v in self.design.variables])
+        _check_solver_options(self)
+        _check_unique_outputs(self)
         for i, ref in enumerate(self.models):
             where = f"models[{i}]"
             _check_setup(self, ref.setup(where), where)
@@ -160,40 +182,136 @@ class CampaignStudyConfig(ModelsStudy):
     def setups(self) -> dict[str, ModelSetup]:
         """The built model of each ``[[models]]`` entry by label: those built (and checked) on validation
         (each entry keeps its model, :meth:`ModelRef.setup`), the ``hunting`` check stating the ``[stability]``
-        criterion of the study (σ_min, ζ_min, the lowest and the required speed), as the constraint rows do."""
+        criterion of the study (σ_min, ζ_min, the lowest and the required speed, every track constrained), as the
+        constraint rows do."""
         key = "criterion " + ("none" if self.stability is None else self.stability.model_dump_json())
         return {m.label: m.built(key, lambda m=m, i=i: self._with_criterion(m.setup(f"models[{i}]")))
                 for i, m in enumerate(self.models)}
 
     def _with_criterion(self, setup: ModelSetup) -> ModelSetup:
-        check = setup.checks.get("hunting")
-        if self.stability is None or check is None or not hasattr(check, "with_criterion"):
+        if self.stability is None:
             return setup
         spec = self.stability
+        added = {t: setup.other_tracks[t] for t in spec.tracks if t not in setup.stability}
+        if added:  # a track the model does not check by default: its family joins the rows and the check
+            stability = {**setup.stability, **added}
+            setup = replace(setup, stability=stability,
+                            other_tracks={t: f for t, f in setup.other_tracks.items() if t not in added})
+        check = setup.checks.get("hunting")
+        if check is None or not hasattr(check, "with_criterion"):
+            return setup
         lowest = spec.lowest_speed_m_s or spec.required(setup) / spec.speeds
         stated = check.with_criterion(sigma_min=spec.sigma_min, zeta_min=spec.zeta_min, lowest_speed=lowest,
                                       max_speed=spec.required(setup))
+        if added:
+            stated = replace(stated, stability={**stated.stability, **added})
         return replace(setup, checks={**setup.checks, "hunting": stated})
 
 
+# ---------------------------------------------------------------------------------------------- output files
+def campaign_label(model: str, objective: str, method: str, problem: str = "constrained") -> str:
+    """The store name of a campaign: ``<model>-<objective>-<method>``, with ``-unconstrained`` after the model for
+    the unconstrained problem of a study that has constraints."""
+    return f"{model}-{objective}-{method}" if problem == "constrained" else f"{model}-{problem}-{objective}-{method}"
+
+
+def model_tag(label: str, n_models: int) -> str:
+    """The suffix of a model's files: ``""`` for a study of one model, else ``"_<label>"``."""
+    return "" if n_models == 1 else f"_{label}"
+
+
+def tradeoff_stem(name: str, tag: str) -> str:
+    """The stem of a trade-off's files: ``tradeoff_<stem>.csv``, ``pareto_<stem>.csv`` and ``.png``."""
+    return f"{name}{tag}"
+
+
+def surface_stem(variables: tuple[str, str], tag: str) -> str:
+    """The stem of a surface's files: ``<stem>.png``, ``<stem>_constrained.csv``, ``<stem>_unconstrained.csv`` and a
+    table per boundary drawn."""
+    return f"surface_{variables[0]}_{variables[1]}{tag}"
+
+
+def output_files(cfg: CampaignStudyConfig) -> list[tuple[str, str]]:
+    """``(file name, field that names it)`` of every file a run of ``cfg`` may write: the campaign stores
+    (``campaigns/<label>.sqlite``), the per-model before/after, trade-off and surface files.  Two entries with the
+    same file name would overwrite each other."""
+    files: list[tuple[str, str]] = []
+    d = cfg.design
+    for i, ref in enumerate(cfg.models):
+        for prob in d.problems:
+            for objective, method in d.plan(prob):
+                files.append((f"campaigns/{campaign_label(ref.label, objective, method, prob)}.sqlite",
+                              f"models[{i}].label"))
+        tag = model_tag(ref.label, len(cfg.models))
+        shown = cfg.report.outputs or [cfg.objective.output or "objective"]
+        files += [(f"{o}_before_after{tag}.png", "report.outputs") for o in dict.fromkeys(shown)]
+        for j, t in enumerate(cfg.tradeoffs):
+            stem = tradeoff_stem(t.name, tag)
+            files += [(f"{prefix}_{stem}.{ext}", f"tradeoffs[{j}].name")
+                      for prefix, ext in (("tradeoff", "csv"), ("pareto", "csv"), ("pareto", "png"))]
+        boundaries = ["critical"] + [c.output for c in cfg.constraints if c.output]
+        for j, sp in enumerate(cfg.surfaces):
+            stem = surface_stem(sp.variables, tag)
+            suffixes = ["constrained", "unconstrained", *(b.split(" ")[0] for b in boundaries)]
+            files += [(f"{stem}.png", f"surfaces[{j}].variables")]
+            files += [(f"{stem}_{x}.csv", f"surfaces[{j}].variables") for x in suffixes]
+    return files
+
+
+def _check_unique_outputs(cfg: CampaignStudyConfig) -> None:
+    """Refuse two trade-offs of one name, two surfaces over one pair (either order), and any two sections whose
+    files would land on one name (one would overwrite the other); and a file name too long to write."""
+    names = [t.name for t in cfg.tradeoffs]
+    for j, name in enumerate(names):
+        if name in names[:j]:
+            raise ValueError(f"tradeoffs[{j}].name: {name!r} is the name of tradeoffs[{names.index(name)}] too; "
+                             "each trade-off names its files (tradeoff_<name>.csv, pareto_<name>.*): give it another")
+    pairs = [frozenset(sp.variables) for sp in cfg.surfaces]
+    for j, pair in enumerate(pairs):
+        if pair in pairs[:j]:
+            raise ValueError(f"surfaces[{j}].variables: {list(cfg.surfaces[j].variables)} is the pair of "
+                             f"surfaces[{pairs.index(pair)}] (in either order it is one surface, one set of files)")
+    seen: dict[str, str] = {}
+    for name, field in output_files(cfg):
+        if len(name.rpartition("/")[2].encode()) > FILE_NAME_BYTES:
+            raise ValueError(f"{field}: makes the file name {name[:40]}… of {len(name.encode())} bytes, more than "
+                             f"the file system's {FILE_NAME_BYTES}; shorten it")
+        if name in seen and seen[name] != field:
+            raise ValueError(f"{field}: its file {name} is also a file of {seen[name]}; one would overwrite the other "
+                             "— rename one of them")
+        seen.setdefault(name, field)
+
+
+def _check_solver_options(cfg: CampaignStudyConfig) -> None:
+    """The design layer's own check of the solver options (:func:`railopt.design.solve.method_options`) for the
+    trade-offs' methods (the design's own are checked by :class:`CampaignSettings`), naming
+    ``design.options.<key>``."""
+    from railopt.design.solve import method_options
+
+    options = cfg.design.solver_options()
+    for method in dict.fromkeys(t.method for t in cfg.tradeoffs):
+        try:
+            method_options(method, options)
+        except ValueError as exc:
+            raise ValueError(f"design.{exc}") from None
+
+
+# ---------------------------------------------------------------------------------------------- per model
 def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:
     names = [v.name for v in cfg.design.variables]
-    bad = [n for n in names if n not in setup.designable]
-    if bad:
-        raise ValueError(f"design.variables: {bad} are not parameters of {where}; choose from {list(setup.designable)}")
-    setup.parameter_map.check_variables(cfg.design.variables)  # stiffness, damping, mass, inertia ≥ 0
+    setup.parameter_map.check_variables(cfg.design.variables, "design.variables", where)  # names, then ≥ 0 bounds
     outputs = setup.family.output_names
     specs = [("objective", cfg.objective)] + [(f"constraints[{i}]", c) for i, c in enumerate(cfg.constraints)]
     for field, spec in specs:
         if spec.output is not None and spec.output not in outputs:
-            raise ValueError(f"{field}.output: unknown output {spec.output!r} of {where}; outputs are {list(outputs)}")
+            raise ValueError(f"{field}.output: {where}: {not_one_of(spec.output, outputs, 'output')}")
     _check_rms(cfg, setup, where)
     before = [cfg.report.before] if cfg.report.before else []
     for field, named in (("design.start_from", cfg.design.start_from), ("report.compare", cfg.report.compare),
                          ("report.before", before)):
         for name in named:
             if name not in setup.named_designs:
-                raise ValueError(f"{field}: {where} has no named design {name!r}; it has {sorted(setup.named_designs)}")
+                raise ValueError(f"{field}: {where}: {not_one_of(name, sorted(setup.named_designs), 'named design')}")
             missing = [n for n in names if n not in setup.named_designs[name]]
             if missing:
                 raise ValueError(f"{field}: named design {name!r} of {where} does not set {missing}")
@@ -206,27 +324,28 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
     for field, wanted in (("report.outputs", cfg.report.outputs), ("report.inch_outputs", cfg.report.inch_outputs),
                           ("report.published", list(cfg.report.published)),
                           ("tradeoffs.output", [t.output for t in cfg.tradeoffs if t.output])):
-        bad = [o for o in wanted if o not in outputs]
-        if bad:
-            raise ValueError(f"{field}: {bad} are not outputs of {where}; outputs are {list(outputs)}")
+        for o in wanted:
+            if o not in outputs:
+                raise ValueError(f"{field}: {where}: {not_one_of(o, outputs, 'output')}")
     for t in cfg.tradeoffs:
         needed = "hunting" if t.check == "damping" else t.check
         if needed is not None and needed not in setup.checks:
-            raise ValueError(f"tradeoffs.{t.name}.check: {where} has no check {needed!r}")
+            raise ValueError(f"tradeoffs.{t.name}.check: {where}: {not_one_of(needed, sorted(setup.checks), 'check')}")
         if t.check in ("hunting", "damping") and not setup.stability:
             raise ValueError(f"tradeoffs.{t.name}.check: {where} has no stability family to sweep against")
     for i, c in enumerate(cfg.constraints):
         if c.clearance is not None and c.clearance not in setup.limits:
-            raise ValueError(f"constraints[{i}].clearance: {where} has no clearance {c.clearance!r}; it has "
-                             f"{sorted(setup.limits)} (the vehicle file's [clearances])")
+            raise ValueError(f"constraints[{i}].clearance: {where}: "
+                             f"{not_one_of(c.clearance, sorted(setup.limits), 'clearance')} (the vehicle file's "
+                             "[clearances])")
     if cfg.stability is not None:
-        if not setup.stability:
-            raise ValueError(f"stability: {where} has no forward speed (no stability family to constrain)")
-        bad = [t for t in cfg.stability.tracks if t not in setup.stability]
-        if bad:
-            raise ValueError(f"stability.tracks: {bad} are not tracks of {where}; it has {sorted(setup.stability)}")
-        if cfg.stability.required(setup) is None:
-            raise ValueError(f"stability.required_speed_m_s: {where} has no maximum operating speed; give one")
+        _check_stability(cfg, setup, where)
+    for j, t in enumerate(cfg.tradeoffs):
+        lowest = (cfg.stability.lowest_speed_m_s if cfg.stability is not None else None)
+        if t.check == "hunting" and lowest is not None and min(t.epsilons) <= lowest:
+            raise ValueError(f"tradeoffs[{j}].epsilons: a required speed of {min(t.epsilons):g} m/s is not above "
+                             f"stability.lowest_speed_m_s = {lowest:g} m/s: its stability rows would collapse onto one "
+                             "speed")
     for sp in cfg.surfaces:
         bad = [v for v in sp.variables if v not in names]
         if bad or sp.variables[0] == sp.variables[1]:
@@ -235,7 +354,7 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
         raise ValueError(f"report.locus_speeds_m_s: {where} has no forward speed")
     for name in cfg.design.checks:
         if name not in setup.checks:
-            raise ValueError(f"design.checks: {where} has no check {name!r}; it has {sorted(setup.checks)}")
+            raise ValueError(f"design.checks: {where}: {not_one_of(name, sorted(setup.checks), 'check')}")
     # the model must evaluate at every start before anything is written
     for name in cfg.design.start_from:
         point = [setup.named_designs[name][n] for n in names]
@@ -250,6 +369,60 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
             setup.family.at().response_maxima(band_hz=cfg.objective.band_hz, exact=False, output=output)
         except ValueError as exc:
             raise ValueError(f"objective.band_hz: {where}: {exc}") from None
+
+
+def _check_stability(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:
+    """``[stability]`` against the model: a forward speed, known tracks, a required speed above the lowest, and
+    rows that constrain something: every ``exclude`` entry names a mode of the model, and not every mode is left
+    out (a vacuous constraint is refused, naming the field)."""
+    spec = cfg.stability
+    if not setup.stability:
+        raise ValueError(f"stability: {where} has no forward speed (no stability family to constrain)")
+    families = {**setup.stability, **setup.other_tracks}
+    for t in spec.tracks:
+        if t not in families:
+            raise ValueError(f"stability.tracks: {where} has no {t!r} track (its vehicle file has no [track] table); "
+                             f"it has {sorted(families)}")
+    required = spec.required(setup)
+    if required is None:
+        raise ValueError(f"stability.required_speed_m_s: {where} has no maximum operating speed; give one")
+    spec.check_lowest(required, "required_speed_m_s" if spec.required_speed_m_s else
+                      f"the maximum operating speed of {where}", "stability.")
+    _check_exclude(spec, {t: families[t] for t in (spec.tracks or setup.stability)}, required, where)
+
+
+def _check_exclude(spec, families: dict, required: float, where: str) -> None:
+    """Each ``exclude`` entry must leave out some mode of the existing design at a row speed on some track, and the
+    entries together must keep at least one mode at every row speed on every track (by the rows' own rule,
+    :func:`railopt.models.stability_rows._family_rows`); an unknown name gets a did-you-mean among the modes'
+    names and groups."""
+    if not spec.exclude:
+        return
+    from railopt.models.stability import modes
+    from railopt.models.stability_rows import _family_rows
+
+    speeds = spec.grid(required)
+    matched = [False] * len(spec.exclude)
+    names: set[str] = set()
+    for track, family in families.items():
+        kept = [keep for *_, keep in _family_rows(family, None, speeds, ())]
+        for i, entry in enumerate(spec.exclude):
+            rows = [keep for *_, keep in _family_rows(family, None, speeds, [entry])]
+            matched[i] |= any(bool((a != b).any()) for a, b in zip(kept, rows, strict=True))
+        left = [keep for *_, keep in _family_rows(family, None, speeds, spec.exclude)]
+        for speed, keep in zip(speeds, left, strict=True):
+            if not keep.any():
+                raise ValueError(f"stability.exclude: {spec.exclude} leaves out every mode of {where} on {track} track "
+                                 f"at {speed:g} m/s: the stability constraint would constrain nothing")
+        for speed in (speeds[0], speeds[-1]):
+            table = modes(family, speed=speed)
+            names |= set(table["name"]) | set(table["group"])
+    for i, entry in enumerate(spec.exclude):
+        if not matched[i]:
+            unknown = not_one_of(entry, sorted(names), "mode name")
+            raise ValueError(f"stability.exclude[{i}]: {where}: {unknown} (no mode of the existing design on "
+                             f"{'/'.join(families)} track between {speeds[0]:g} and {speeds[-1]:g} m/s is named so, "
+                             "nor starts so: the entry leaves nothing out)")
 
 
 def _check_rms(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> None:
