@@ -58,6 +58,8 @@ BUNDLED = bundled_vehicles()
 """The bundled vehicle names (:func:`bundled_vehicles`), read once at import."""
 MAX_DEPTH = 32  # nesting of an arithmetic expression
 INERTIA_RTOL = 1e-9  # eigenvalues of an inertia tensor below this fraction of the largest count as zero
+MASS_RTOL = 1e-9  # a body's mass (its smallest moment) below this fraction of the vehicle's largest: refused
+# (the state matrix refuses a mass matrix whose LU pivots fall below 1e-14 of the largest: models/system.py)
 
 
 class VehicleFileError(ValueError):
@@ -204,6 +206,7 @@ def _parse(data: Mapping[str, Any], path: str, length_overrides: Mapping[str, fl
     if not f.bodies:
         raise ValueError("no [[bodies]]: a vehicle needs at least one body")
     bodies = [_body(i, b, names) for i, b in enumerate(f.bodies)]
+    _check_inertia_scale(bodies)
     body_names = [b.name for b in bodies]
     dup = {n for n in body_names if body_names.count(n) > 1}
     if dup:
@@ -225,7 +228,7 @@ def _parse(data: Mapping[str, Any], path: str, length_overrides: Mapping[str, fl
     vehicle = Vehicle(name=name, description=f.vehicle.description, bodies=tuple(bodies),
                       elements=tuple(elements), constraints=tuple(constraints), contact=contact, track=track,
                       cab_point=cab_point, lengths=Lengths(lengths, lsources),
-                      clearances=Lengths(*_named_values(f.clearances, "clearances")), aliases={}, path=path)
+                      clearances=_clearances(f.clearances), aliases={}, path=path)
     _check_aliases(vehicle, f.aliases)
     vehicle = Vehicle(**{**vehicle.__dict__, "aliases": dict(f.aliases), "_cache": {}})
     _check_contact(vehicle)
@@ -273,6 +276,35 @@ def _body(i: int, b: BodySchema, names: Mapping[str, float]) -> Body:
                          "rotation of a body needs inertia")
     inertia = tuple(map(tuple, tensor)) if isinstance(b.inertia_kg_m2[0], tuple) else tuple(np.diag(tensor))
     return Body(b.name, mass, inertia, _vector(b.cg_m, names, f"{label}.cg_m"), b.kind, b.source)
+
+
+def _check_inertia_scale(bodies: list[Body]) -> None:
+    """Every body's mass and principal moments at least :data:`MASS_RTOL` of the vehicle's largest: a body (nearly)
+    without mass or inertia leaves the mass matrix singular and every analysis refuses it later, naming no body."""
+    heaviest = max(bodies, key=lambda b: b.mass)
+    moments = {b.name: np.linalg.eigvalsh(np.asarray(b.inertia)) for b in bodies}
+    largest = max(bodies, key=lambda b: moments[b.name][-1])
+    for i, b in enumerate(bodies):
+        label = f"bodies[{i}] ({b.name})"
+        if b.mass < MASS_RTOL * heaviest.mass:
+            raise ValueError(f"{label}.mass_kg: {b.mass:g} kg is {b.mass / heaviest.mass:.3g} of the heaviest body "
+                             f"({heaviest.name}, {heaviest.mass:g} kg): a body without mass makes the mass matrix "
+                             "singular; the unit is kg")
+        if moments[b.name][0] < MASS_RTOL * moments[largest.name][-1]:
+            raise ValueError(f"{label}.inertia_kg_m2: principal moments {_moments(moments[b.name])} kg m^2, the "
+                             f"smallest {moments[b.name][0] / moments[largest.name][-1]:.3g} of the largest moment of "
+                             f"the vehicle ({largest.name}, {moments[largest.name][-1]:.4g} kg m^2): a rotation "
+                             "without inertia makes the mass matrix singular; the unit is kg m^2")
+
+
+def _clearances(table: Mapping[str, Any]) -> Lengths:
+    """The ``[clearances]``: each a free travel before a stop, positive (a stroke limit ≤ 0 admits no design)."""
+    values, sources = _named_values(table, "clearances")
+    for k, x in values.items():
+        if not x > 0.0:
+            raise ValueError(f"clearances.{k}: must be positive (a free travel before a stop, m), got {x!r}: a limit "
+                             "≤ 0 on a stroke makes every design infeasible")
+    return Lengths(values, sources)
 
 
 def _moments(eig: np.ndarray) -> str:
@@ -447,6 +479,6 @@ def _track(t: TrackSchema | None, names: Mapping[str, float]) -> TrackSpec | Non
 
 
 __all__ = [
-    "BUNDLED", "INERTIA_RTOL", "MAX_DEPTH", "VehicleFileError", "bundled_path", "bundled_vehicles", "evaluate",
-    "load_vehicle", "parse_vehicle", "read_vehicle_file",
+    "BUNDLED", "INERTIA_RTOL", "MASS_RTOL", "MAX_DEPTH", "VehicleFileError", "bundled_path", "bundled_vehicles",
+    "evaluate", "load_vehicle", "parse_vehicle", "read_vehicle_file",
 ]

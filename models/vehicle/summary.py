@@ -173,8 +173,9 @@ def vehicle_summary(vehicle: Vehicle, speed: float | None = None, track: str = "
 
 
 def main_validate_vehicle(path: str) -> tuple[str, int]:
-    """``railopt validate car.toml`` for a vehicle file: ``(text, 0)`` when it loads (plausibility warnings listed),
-    ``(error, 2)`` otherwise."""
+    """``railopt validate car.toml`` for a vehicle file: ``(text, 0)`` when it loads, its plausibility warnings listed
+    one a line as ``warning: <file>: <key>: <what is unusual>: <likely slip>``; ``(error, 2)`` otherwise (a file that
+    does not load: ``railopt: error: <file>: <key>: <what>``)."""
     from railopt.models.vehicle.loader import load_vehicle
 
     try:
@@ -183,7 +184,7 @@ def main_validate_vehicle(path: str) -> tuple[str, int]:
         return f"railopt: error: {exc}", 2
     warnings = plausibility(vehicle)
     head = f"{path}: valid vehicle file ({vehicle!r})"
-    return "\n".join([head] + [f"warning: {vehicle.path}: {w}" for w in warnings]) + "\n", 0
+    return "\n".join([head] + [f"warning: {w.line()}" for w in warnings]) + "\n", 0
 
 
 __all__ = ["SPEED_RANGE", "TOL", "VehicleSummary", "main_validate_vehicle", "mode_table", "vehicle_summary"]

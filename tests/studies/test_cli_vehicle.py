@@ -62,8 +62,8 @@ def test_validate_vehicle_file_prints_its_unit_slip_warning(tmp_path):
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     assert lines[0].startswith("car.toml: valid vehicle file (")
-    assert "warning: car.toml: contact.conicity: conicity 2.5 is above 0.5: almost surely per cent (write 0.025)" \
-        in lines
+    assert "warning: car.toml: contact.conicity: conicity 2.5 is above 0.5: looks like per cent (2.5 → 0.025) or " \
+        "10× too large (→ 0.25)?" in lines
 
 
 def test_validate_good_vehicle_file_has_no_conicity_warning(tmp_path):
