@@ -11,9 +11,10 @@ system and one eigen-decomposition.
 
 A ride objective (:class:`RMSTarget`) is the RMS of one output per metre of rail irregularity under a track
 spectrum at the family's speed over a band (:func:`railopt.models.random_response.random_response`, adaptive
-quadrature), a single function; its gradient is analytic on the final quadrature rule:
+quadrature), a single function; its gradient is analytic on the final quadrature rule
+(:func:`railopt.models.random_response.rms_gradient` with dp/dx folded in:
 ``dRMS/dx = Σ_k w_k S_k Re(conj(H_k) dH_k/dx) / RMS`` with ``dH/dx = (iω)^q c·Z⁻¹(dF/dx − dZ/dx Z⁻¹F)`` from the
-member's tangent (the rule's nodes held fixed: the derivative of the discrete sum, equal to the derivative of
+member's tangent; the rule's nodes held fixed: the derivative of the discrete sum, equal to the derivative of
 the RMS to the quadrature tolerance).
 
 Where an objective does not exist at a design — an unstable member has no steady-state response and no stationary
@@ -33,7 +34,7 @@ import numpy as np
 from railopt.design import DesignVariable, MinimaxProblem
 from railopt.models import LinearSystem
 from railopt.models.modal import growing_roots
-from railopt.models.random_response import RandomResponse, random_response
+from railopt.models.random_response import RandomResponse, random_response, rms_gradient
 from railopt.models.response_maxima import all_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
 from railopt.models.stability_map import least_damping_ratio, stability_map, worst_speed
@@ -53,7 +54,6 @@ __all__ = [
     "minimax_problem",
     "objective_value",
     "response_target",
-    "rms_gradient",
     "rms_target",
     "stability_target",
 ]
@@ -145,46 +145,6 @@ def objective_value(system: LinearSystem, target: ResponseTarget | RMSTarget) ->
     unstable = _no_steady_state(system)
     reason = unstable + "; no steady-state response exists" if unstable else _undamped_in_band(system, target.band)
     return float("inf"), f"{reason}; the band maximum is unbounded" if reason else "the band maximum is unbounded"
-
-
-def rms_gradient(system: LinearSystem, response, dp: np.ndarray) -> np.ndarray:
-    """d RMS / dx (d,) of a :class:`~railopt.models.random_response.RandomResponse` of ``system`` (a family member
-    with its tangent) on the response's own quadrature rule, for ``dp = dp/dx`` (P, d).
-
-    ``RMS² = Σ_k w_k S_k |H_k|²`` so ``dRMS = Σ_k w_k S_k Re(conj(H_k) dH_k) / RMS``, with
-    ``dH = (iω)^q c·Z⁻¹(dF − dZ X)``, ``X = Z⁻¹F``, ``dZ = dK − ω²dM + iω dC`` folded over the design variables
-    first (d small).  Outputs with a feedthrough are not supported (``ValueError``)."""
-    out = system.outputs[response.output]
-    if out.feedthrough is not None:
-        raise ValueError(f"output: {response.output!r} has a feedthrough; the analytic RMS gradient does not cover it")
-    t = system.tangent
-    if t is None:
-        raise ValueError("system: carries no parameter derivatives; build it with ParametricSystem.at(p)")
-    d = dp.shape[1]
-    if response.rms == 0.0:
-        return np.zeros(d)
-    w = response.rule.omega
-    q = {"displacement": 0, "velocity": 1, "acceleration": 2}[out.quantity]
-    F = system.forcing.values(w)  # (N, n)
-    Z = system.K[None] - w[:, None, None] ** 2 * system.M[None] + 1j * w[:, None, None] * system.C[None]
-    X = np.linalg.solve(Z, F[..., None])[..., 0]
-    adj = np.linalg.solve(np.swapaxes(Z, 1, 2), np.broadcast_to(out.row.astype(complex), F.shape)[..., None])[..., 0]
-    gain = (1j * w) ** q
-    H = gain * np.sum(adj * F, axis=1)
-    weight = response.rule.weights * response.input_psd
-    moving = np.flatnonzero(np.any(dp != 0.0, axis=1))
-    grad = np.zeros(d)
-    for j in range(d):
-        c = dp[moving, j]
-        dM, dC, dK = (np.tensordot(c, a[moving], axes=1) for a in (t.dM, t.dC, t.dK))
-        dZX = X @ dK.T - (w**2)[:, None] * (X @ dM.T) + 1j * w[:, None] * (X @ dC.T)
-        dF = np.zeros_like(F)
-        for i, ci in zip(moving, c, strict=True):
-            if t.dF[i] is not None and ci != 0.0:
-                dF += ci * t.dF[i].values(w)
-        dH = gain * np.sum(adj * (dF - dZX), axis=1)
-        grad[j] = float(np.dot(weight, (np.conj(H) * dH).real)) / response.rms
-    return grad
 
 
 @dataclass(frozen=True)

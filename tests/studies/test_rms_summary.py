@@ -188,3 +188,48 @@ def test_an_infinite_critical_speed_prints_as_stable_over_the_searched_range(coa
     stability = [ln for ln in summary.splitlines() if ln.startswith(("| before | hunting", "| after | hunting"))]
     assert len(stability) == 2 and all(ln.count(words) == 2 for ln in stability)
     assert "| inf |" not in summary and "|  | stable" not in summary
+
+
+# ---------------------------------------------------------------------------------------------- worse, said explicitly
+def test_a_before_after_output_that_got_worse_is_flagged_with_its_signed_change():
+    """The flagship's before/after (issue 27 item 11): at the recommended corner the cab acceleration falls but the
+    cab displacement rises; the table says so (``worse``, signed ``change``), recomputed by a fresh vehicle, and
+    the reduction factor below 1 is no longer the only sign of it."""
+    from railopt.studies.cli import STUDIES_DIR
+    from railopt.studies.config import load_study
+    from railopt.studies.kinds.campaign.sections import _before_after
+
+    _, cfg, _ = load_study(STUDIES_DIR / "cab_lateral_minimax.toml")
+    setup = cfg.setups()["sd40-2"]
+    after = {"secondary_lateral_stiffness": 1.0e5, "sidebearer1_vertical_stiffness": 2.0e8,
+             "lateral_shock_absorber_damping": 1.17378e5, "rotational_shock_absorber_damping": 1.0e4}
+    band = (0.0, 2 * math.pi * 3.0)
+    table = _before_after(cfg, setup, after, band).table.set_index("output")
+    fresh = {"before": load_vehicle("sd40-2").cab_lateral(),
+             "after": load_vehicle("sd40-2").with_parameters(after).cab_lateral()}
+    for output in ("cab_acceleration", "cab_displacement"):
+        before, later = (fresh[k].peak(band_rad_s=band, output=output) for k in ("before", "after"))
+        row = table.loc[output]
+        assert row["before"] == pytest.approx(before, rel=1e-9) and row["after"] == pytest.approx(later, rel=1e-9)
+        assert row["change"] == pytest.approx(later / before - 1, rel=1e-9)
+        assert bool(row["worse"]) == (later > before)
+        assert row["measure"] == "peak"
+    assert not table.loc["cab_acceleration", "worse"] and table.loc["cab_displacement", "worse"]
+    assert table.loc["cab_displacement", "change"] > 0 > table.loc["cab_acceleration", "change"]
+
+
+@pytest.mark.slow
+def test_a_side_measure_that_got_worse_is_flagged_in_the_tables_and_the_summary(coach):
+    """The coach's RMS optimum more than doubles its sinusoid peak (the stiffened primary passes the bogie motion):
+    the before/after table's ``peak_worse``/``peak_change`` and the summary say so."""
+    out = coach
+    row = pd.read_csv(out / "recommended.csv").set_index("measure").loc["rms"]
+    values = {n: float(row[n]) for n in COACH["variables"]}
+    before, after = _fresh_peak(COACH, {}), _fresh_peak(COACH, values)
+    assert after > before  # the input of the test: a side measure that got worse
+    ba = pd.read_csv(out / "before_after.csv").set_index("output").loc[SEAT]
+    assert bool(ba["peak_worse"]) and ba["peak_change"] == pytest.approx(after / before - 1, rel=1e-9)
+    summary = (out / "summary.md").read_text()
+    signed = f"+{100 * (after / before - 1):.3g} % (WORSE)"
+    assert f"**Side measure worse after optimisation:** certified peak of {SEAT} ({signed})" in summary
+    assert f"| … its change against existing |  | {signed} |" in summary

@@ -138,7 +138,7 @@ def comparison_section(result: CampaignResult, writer: Writer) -> list[str]:
         "",
     ]
     for ref in cfg.report.compare:
-        cols = ["model", "problem", "objective", "method", f"{ref}_peak", f"{ref}_rms", f"change_vs_{ref}"]
+        cols = ["model", "vehicle", "problem", "objective", "method", f"{ref}_peak", f"{ref}_rms", f"change_vs_{ref}"]
         cols += [f"{n}_change_vs_{ref}" for n in names]
         lines += [f"Against `{ref}` (its certified peak and RMS, and the best design's signed change in the "
                   f"campaign's own measure, negative: better; then the differences of the variables):", "",
@@ -169,7 +169,8 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
     setup = cfg.setups()[model]
     dpi = cfg.report.dpi
     writer.table(_csv(result, ba.table, model), f"before_after{tag}")
-    worse = ba.table[ba.table["worse"].fillna(False).astype(bool)]
+    worse = ba.table[ba.table["worse"].eq(True)]
+    side_worse = ba.table[ba.table["peak_worse"].eq(True)] if "peak_worse" in ba.table.columns else ba.table.iloc[0:0]
     measure = ("the RMS per metre under the spectrum at the model's speed (the certified band maxima are the "
                "`peak_…` side columns)" if s.measure == "rms" else "the certified band maximum")
     md = [f"## {model}: before (`{cfg.report.before}`) and after (best {best['objective']} optimum, "
@@ -182,6 +183,10 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
         md += ["**Worse after optimisation:** " + ", ".join(
             f"{r['output']} ({_signed(r['change'], True)})" for _, r in worse.iterrows())
                + " — only the objective output was minimised; the others are shown, not optimised.", ""]
+    if len(side_worse):
+        md += ["**Side measure worse after optimisation:** certified peak of " + ", ".join(
+            f"{r['output']} ({_signed(r['peak_change'], True)})" for _, r in side_worse.iterrows())
+               + " — the RMS was minimised, not the sinusoid peak.", ""]
     md += [f"Active bounds at the optimum: {', '.join(ba.active) if ba.active else 'none'}. The thesis approximation "
            f"(4.71)–(4.73) reads {ba.thesis:.5g} at this optimum against the certified maximum {ba.exact:.5g} "
            f"({100 * (ba.thesis - ba.exact) / ba.exact:+.2f} %).", ""]
@@ -346,8 +351,11 @@ def _design_table(result: CampaignResult, s: ModelSections, rec: Recommended, re
         add("reduction factor against existing (existing / U)", 1.0, rec.existing_U / rec.U,
             None if ref is None else rec.existing_U / ref["U"])
     for measure, (existing, value) in (rec.side or {}).items():
-        add(f"side measure, not minimised: {measure_label(cfg, setup, measure)}", existing, value,
-            None if ref is None else ref["side"].get(measure))
+        unc = None if ref is None else ref["side"].get(measure)
+        add(f"side measure, not minimised: {measure_label(cfg, setup, measure)}", existing, value, unc)
+        if existing is not None:
+            add("… its change against existing", None, _signed(*change(existing, value)),
+                None if unc is None else _signed(*change(existing, unc)))
     for name, payload in rec.checks.items():
         for key, value in payload.items():
             if isinstance(value, bool):

@@ -123,7 +123,10 @@ def start_outcomes(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], star
             values = {n: float(r[n]) for n in names}
             target = (rms_target(cfg.objective, setup) if MEASURES[r["objective"]] == "rms"
                       else response_target(cfg.objective, setup, exact=r["objective"] == "exact"))
-            value, why = objective_value(setup.family.at(_p(cfg, setup, values)), target)
+            try:
+                value, why = objective_value(setup.family.at(_p(cfg, setup, values)), target)
+            except Exception:  # noqa: BLE001  (the model fails there: the solver's status and message say how)
+                value, why = 0.0, ""
             if np.isfinite(value):  # the design layer's U is inf for another reason (a lost worker, an error)
                 outcome, reason = str(r["status"]), str(r["message"])
             else:
@@ -251,8 +254,9 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
                   band: tuple[float, float], measure: str = "peak") -> BeforeAfter:
     """Maxima (or RMS), FRFs, checks and (with forward speed) root loci of the named design ``report.before`` and
     the optimum ``after`` (Figs 4.13–4.17).  ``before``/``after`` are in ``measure`` (the certified band maximum,
-    or the RMS per metre under the spectrum with the certified maxima as ``peak_…`` side columns), with the
-    signed relative ``change`` (negative: better) and ``worse`` (after > before) beside the reduction factor."""
+    or the RMS per metre under the spectrum with the certified maxima as ``peak_…`` side columns, their own
+    ``peak_change`` and ``peak_worse`` too), with the signed relative ``change`` (negative: better) and ``worse``
+    (after > before) beside the reduction factor."""
     p_before = _p(cfg, setup, setup.named_designs[cfg.report.before])
     p_after = _p(cfg, setup, after)
     sys_b, sys_a = setup.family.at(p_before), setup.family.at(p_after)
@@ -267,7 +271,9 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
         if measure == "rms":
             target = rms_target(cfg.objective.model_copy(update={"output": o}), setup)
             (vb, why_b), (va, why_a) = objective_value(sys_b, target), objective_value(sys_a, target)
+            peak_change, peak_worse = change(rb.value, ra.value)
             main, side = {"before": vb, "after": va}, {f"peak_{k}": v for k, v in peaks.items()}
+            side |= {"peak_change": peak_change, "peak_worse": peak_worse}
             side |= {k: why for k, why in (("before_reason", why_b), ("after_reason", why_a)) if why}
         else:
             main, side = {"before": rb.value, "after": ra.value}, {k: v for k, v in peaks.items()
