@@ -150,8 +150,9 @@ class _VehicleParser(argparse.ArgumentParser):
 
 
 def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
-    """``railopt vehicle NAME_OR_FILE [--speed S] [--track rigid|flexible] [--markdown]``: the report and the exit
-    code (0; 2 for a file error, with the message ``<file>: <key path>: <what>``).
+    """``railopt vehicle NAME_OR_FILE [--speed S] [--track rigid|flexible] [--markdown] [--modes [PNG]]``: the report
+    and the exit code (0; 2 for a file error, with the message ``<file>: <key path>: <what>``); ``--modes`` also
+    writes the mode-shape figure (:func:`railopt.studies.output.mode_figure.write_mode_figure`) and names it last.
 
     ``argv`` are the arguments after ``vehicle``; ``--speed`` is the speed of the modes table in m/s (default
     20 m/s).  Returns ``(text, code)``: the plain-text or Markdown report of
@@ -160,12 +161,15 @@ def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
     """
     from railopt.models.vehicle.loader import load_vehicle
     from railopt.models.vehicle.summary import vehicle_summary
+    from railopt.studies.output.mode_figure import write_mode_figure
 
     parser = _VehicleParser(prog="railopt vehicle", description="Summary of a vehicle file.")
     parser.add_argument("vehicle", help="bundled name (sd40-2, manchester-coach, single-wheelset) or a .toml file")
     parser.add_argument("--speed", type=float, default=None, help="speed of the modes table, m/s (default 20)")
     parser.add_argument("--track", choices=("rigid", "flexible"), default="rigid")
     parser.add_argument("--markdown", action="store_true", help="Markdown instead of plain text")
+    parser.add_argument("--modes", nargs="?", const="", default=None, metavar="PNG",
+                        help="also draw every mode on the plan view at the table's speed (default <name>_modes.png)")
     try:
         args = parser.parse_args(list(argv))
     except _UsageError as exc:
@@ -173,10 +177,13 @@ def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
     except SystemExit:  # --help
         return parser.format_help(), 0
     try:
-        summary = vehicle_summary(load_vehicle(args.vehicle), speed=args.speed, track=args.track)
+        vehicle = load_vehicle(args.vehicle)
+        summary = vehicle_summary(vehicle, speed=args.speed, track=args.track)
+        drawn = None if args.modes is None else write_mode_figure(vehicle, summary.speed, args.track, args.modes)
     except ValueError as exc:
         return f"railopt: error: {exc}", 2
-    return (summary.to_markdown() if args.markdown else summary.to_text()), 0
+    text = summary.to_markdown() if args.markdown else summary.to_text()
+    return (text if drawn is None else f"{text.rstrip()}\n\nMode shapes: {drawn}\n"), 0
 
 
 def cmd_vehicle(args: argparse.Namespace) -> int:

@@ -4,13 +4,14 @@ For each model with forward speed (``[[models]]`` naming e.g. ``vehicle_lateral`
 root locus over ``[speeds]`` (Fig 4.4), the least damping ratio and the spectral abscissa at each
 speed, and the critical speed (lowest S with a root in Re s > 0, bracketed and refined by Brent's
 method to a tolerance, §4.3.1, (4.51)–(4.59)).  Optional ``[[sensitivity]]`` tables repeat the
-critical-speed search with one vehicle parameter scaled by each factor.
+critical-speed search with one vehicle parameter scaled by each factor, in the order given.  Each model's modes
+are drawn on the vehicle's plan view (``modes_<label>.png``) at its critical speed, or at ``modes_speed_m_s``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
@@ -21,15 +22,17 @@ from railopt.models.stability import critical_speed, root_locus
 from railopt.models.units import MPH
 from railopt.studies.catalog import ModelRef, ModelSetup, ModelsStudy
 from railopt.studies.catalog.vehicle import load
-from railopt.studies.config import FiniteModel, Interval
+from railopt.studies.catalog.views import stability_view, vehicle_view
+from railopt.studies.config import FiniteModel, Interval, not_one_of
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
-from railopt.studies.output.figures import plot_root_locus
+from railopt.studies.output.figures import plot_root_locus, vehicle_label
 from railopt.studies.output.map_figure import plot_stability_map
 from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.mode_figure import plot_mode_shapes
 from railopt.studies.output.writer import Writer
 
-__all__ = ["CriticalSpec", "SensitivitySpec", "SpeedGrid", "SpeedSweepConfig", "SpeedSweepResult", "compute",
-           "report"]
+__all__ = ["CriticalSpec", "ModeShapes", "SensitivitySpec", "SpeedGrid", "SpeedSweepConfig", "SpeedSweepResult",
+           "compute", "report", "sensitivity_pivot"]
 
 
 class SpeedGrid(FiniteModel):
@@ -58,16 +61,18 @@ class CriticalSpec(SpeedGrid):
 
 
 class SensitivitySpec(FiniteModel):
-    """One sensitivity table: the critical speed with ``parameter`` scaled by each of ``factors`` (> 0)."""
+    """One sensitivity table: the critical speed with ``parameter`` scaled by each of ``factors`` (≥ 0, in the order
+    given; 0 switches an element off, where the vehicle can run without it)."""
 
     parameter: str
     factors: list[float] = Field(min_length=1)
 
     @field_validator("factors")
     @classmethod
-    def _positive(cls, v: list[float]) -> list[float]:
-        if any(f <= 0 for f in v):
-            raise ValueError(f"factors must be positive, got {v}")
+    def _non_negative(cls, v: list[float]) -> list[float]:
+        if any(f < 0 for f in v):
+            raise ValueError(f"factors must be ≥ 0 (a scaled stiffness, damping, mass or length keeps its sign), "
+                             f"got {v}")
         return v
 
 
@@ -82,6 +87,9 @@ class SpeedSweepConfig(ModelsStudy):
     critical: CriticalSpec
     sensitivity: list[SensitivitySpec] = Field(default_factory=list)
     dpi: int = Field(110, ge=50, le=300, strict=True)
+    modes_speed_m_s: float | None = Field(None, gt=0, lt=1000, allow_inf_nan=False,
+                                          description="speed of the mode-shape figures, m/s (default: each model's "
+                                                      "critical speed; the search's upper end when it is stable)")
 
     @model_validator(mode="after")
     def _resolve(self) -> SpeedSweepConfig:
@@ -89,24 +97,35 @@ class SpeedSweepConfig(ModelsStudy):
             setup = ref.setup(f"models[{i}]")
             if not setup.stability:
                 raise ValueError(f"models[{i}].model: {ref.model!r} has no forward speed; use a vehicle model")
-            for j, sens in enumerate(self.sensitivity):
-                _variant(ref, sens.parameter, sens.factors[0], f"sensitivity[{j}]")
+            for j, sens in enumerate(self.sensitivity):  # every variant is built (and kept for the run)
+                for k, factor in enumerate(sens.factors):
+                    _variant(ref, sens.parameter, factor, f"sensitivity[{j}]", f"sensitivity[{j}].factors[{k}]")
         return self
 
 
-def _variant(ref: ModelRef, parameter: str, factor: float, where: str) -> ModelSetup:
-    """The model with one vehicle parameter scaled by ``factor`` (through the ``parameters`` option)."""
+def _variant(ref: ModelRef, parameter: str, factor: float, where: str, at: str | None = None) -> ModelSetup:
+    """The model with one vehicle parameter scaled by ``factor`` (through the ``parameters`` option); a variant the
+    vehicle cannot be built with (a zero mass) is refused naming ``at`` (default ``where``)."""
     options = ref.validated_options(where)
     if "parameters" not in type(options).model_fields:
         raise ValueError(f"{where}.parameter: model {ref.model!r} takes no parameter overrides")
     vehicle = load(options)
-    try:
-        base = vehicle.parameter(parameter)
-    except ValueError as exc:
-        raise ValueError(f"{where}.parameter: {exc}") from None
+    names = vehicle.parameter_names()
+    if parameter not in names:
+        raise ValueError(f"{where}.parameter: {not_one_of(parameter, names, 'parameter')} (vehicle {vehicle.name!r})")
+    base = vehicle.parameter(parameter)
     changed = {**options.parameters, parameter: factor * base}
     variant = ref.model_copy(update={"options": {**ref.options, "parameters": changed}})
-    return ref.built(f"variant {parameter} x{factor!r}", lambda: variant.setup(where))  # validation's, in compute
+
+    def build() -> ModelSetup:
+        try:
+            return variant.setup(where)
+        except ValueError as exc:
+            reason = str(exc).removeprefix(f"{where}.options: ")
+            raise ValueError(f"{at or where}: {parameter} × {factor:g} = {factor * base:g} gives no model: "
+                             f"{reason}") from None
+
+    return ref.built(f"variant {parameter} x{factor!r}", build)  # validation's, in compute
 
 
 def _critical(label: str, setup: ModelSetup, spec: CriticalSpec) -> tuple[dict, pd.DataFrame]:
@@ -124,9 +143,22 @@ def _critical_row(label: str, setup: ModelSetup, spec: CriticalSpec) -> dict:
     return _critical(label, setup, spec)[0]
 
 
+@dataclass(frozen=True, eq=False)
+class ModeShapes:
+    """What the mode-shape figure of one model draws: its label, the vehicle view (plan view), the model's system at
+    ``speed`` (m/s; its coordinates the view's) and the figure title (vehicle name and file, speed, track)."""
+
+    label: str
+    view: object
+    system: object
+    speed: float
+    title: str
+
+
 @dataclass(frozen=True)
 class SpeedSweepResult:
-    """Root loci, least damping per speed, critical speeds (``table``), sensitivities and the track effect."""
+    """Root loci, least damping per speed, critical speeds (``table``), sensitivities, the track effect and the mode
+    shapes of each model."""
 
     config: SpeedSweepConfig
     locus: pd.DataFrame
@@ -135,6 +167,36 @@ class SpeedSweepResult:
     sensitivity: pd.DataFrame
     track_effect: pd.DataFrame
     maps: pd.DataFrame
+    shapes: list[ModeShapes] = field(default_factory=list)
+
+
+def _vehicle(ref: ModelRef, where: str):
+    """The model's vehicle (its ``parameters`` applied) and the view of its stability families, or None for a model
+    without a vehicle file."""
+    options = ref.validated_options(where)
+    if not hasattr(options, "vehicle"):
+        return None, None
+    return load(options), stability_view(getattr(options, "view", "lateral"))
+
+
+def _mode_shapes(ref: ModelRef, setup: ModelSetup, row: dict, cfg: SpeedSweepConfig, where: str) -> ModeShapes | None:
+    """The mode shapes of a vehicle model on its first stability track at ``modes_speed_m_s``, else at its critical
+    speed (the critical search's upper end when stable over it); None for a model without a vehicle file."""
+    vehicle, view_name = _vehicle(ref, where)
+    if vehicle is None:
+        return None
+    track = next(iter(setup.stability))
+    view = vehicle_view(vehicle, view_name, track)
+    if cfg.modes_speed_m_s is not None:
+        speed, at = cfg.modes_speed_m_s, "the asked speed"
+    elif math.isfinite(row["critical_speed_m_s"]):
+        speed, at = row["critical_speed_m_s"], "its critical speed"
+    else:
+        speed, at = cfg.critical.range_m_s[1], "the search's upper end (stable over the range)"
+    system = setup.stability_model(setup.defaults).at(speed=speed)
+    title = (f"{ref.label} — {vehicle_label(vehicle.name, vehicle.path)}: modes at {speed:.4g} m/s ({at}), "
+             f"{track} track")
+    return ModeShapes(ref.label, view, system, float(speed), title)
 
 
 def _locus_and_damping(label: str, setup: ModelSetup, speeds: np.ndarray) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -161,27 +223,35 @@ def compute(config: SpeedSweepConfig, context: StudyContext) -> SpeedSweepResult
 
     Critical speeds (m/s and mph) are the lowest speeds with a root in Re s > 0, bracketed on the critical grid and
     refined by Brent to ``tol_m_s`` (§4.3.1, (4.51)–(4.59)); rigid and flexible entries of the same vehicle are
-    compared in ``track_effect``.
+    compared in ``track_effect``; each vehicle model's modes at its critical speed (or ``modes_speed_m_s``) are kept
+    for the mode-shape figure.
     """
     cfg = config
-    loci, critical, damping, sens_rows, maps = [], [], [], [], []
+    loci, critical, damping, sens_rows, maps, shapes = [], [], [], [], [], []
     for i, ref in enumerate(cfg.models):
-        setup = ref.setup(f"models[{i}]")
+        where = f"models[{i}]"
+        setup = ref.setup(where)
         locus, damp = _locus_and_damping(ref.label, setup, cfg.speeds.speeds())
         loci.append(locus)
         damping.append(damp)
         row, intervals = _critical(ref.label, setup, cfg.critical)
-        critical.append(row)
+        vehicle, _ = _vehicle(ref, where)
+        critical.append({"model": ref.label, "vehicle": "" if vehicle is None else
+                         vehicle_label(vehicle.name, vehicle.path), **row})
         maps.append(intervals)
         sens_rows += _sensitivity_rows(cfg, ref)
+        shape = _mode_shapes(ref, setup, row, cfg, where)
+        if shape is not None:
+            shapes.append(shape)
     critical_table = pd.DataFrame(critical)
     return SpeedSweepResult(cfg, pd.concat(loci, ignore_index=True), pd.concat(damping, ignore_index=True),
                             critical_table, pd.DataFrame(sens_rows), _track_effect(cfg, critical_table),
-                            pd.concat(maps, ignore_index=True))
+                            pd.concat(maps, ignore_index=True), shapes)
 
 
 def report(result: SpeedSweepResult, writer: Writer) -> str:
-    """Write the locus, critical-speed, damping (and sensitivity) tables and the root-locus figure; return markdown."""
+    """Write the locus, critical-speed, damping (and sensitivity) tables, the root-locus, stability-map and
+    mode-shape figures; return markdown."""
     cfg, critical_table, sens_table, track_effect = result.config, result.table, result.sensitivity, result.track_effect
     writer.table(result.locus, "root_locus")
     writer.table(critical_table, "critical_speeds")
@@ -191,9 +261,16 @@ def report(result: SpeedSweepResult, writer: Writer) -> str:
     writer.figure(plot_root_locus(result.locus, critical_table), "root_locus", dpi=cfg.dpi)
     if len(result.maps):
         writer.table(result.maps[["model", *[c for c in result.maps.columns if c != "model"]]], "stability_map")
+        vehicles = dict(zip(critical_table["model"], critical_table["vehicle"], strict=True))
         writer.figure(plot_stability_map(result.damping, result.maps, f"{cfg.study.name}: stability map over "
-                                         f"{cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s"),
+                                         f"{cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s",
+                                         vehicles=vehicles),
                       "stability_map", dpi=cfg.dpi)
+    shapes = []
+    for shape in result.shapes:
+        name = writer.figure(plot_mode_shapes(shape.view, shape.system, shape.title), f"modes_{_slug(shape.label)}",
+                             dpi=cfg.dpi)
+        shapes.append(f"![modes of {shape.label} at {shape.speed:.4g} m/s]({name})")
     lines = [f"# {cfg.study.name}", "", cfg.study.description, "",
              f"Root locus over {cfg.speeds.range_m_s[0]:g}–{cfg.speeds.range_m_s[1]:g} m/s; critical speed searched "
              f"in {cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s to ±{cfg.critical.tol_m_s:g} m/s.",
@@ -203,8 +280,7 @@ def report(result: SpeedSweepResult, writer: Writer) -> str:
         lines += _track_effect_sentences(track_effect, sens_table)
         writer.table(track_effect, "track_effect")
     if len(sens_table):
-        pivot = sens_table.pivot_table(index=["parameter", "factor"], columns="model", values="critical_speed_m_s",
-                                       sort=False).reset_index()
+        pivot = sensitivity_pivot(sens_table)
         lines += ["Critical speed (m/s) with one parameter scaled by `factor` (all columns in `sensitivity.csv`):",
                   "", markdown_table(pivot, digits=5), ""]
     if len(result.maps):
@@ -217,7 +293,25 @@ def report(result: SpeedSweepResult, writer: Writer) -> str:
                   markdown_table(result.maps[["model", "start_m_s", "end_m_s", "state", "mode_at_start",
                                               "mode_at_end"]], digits=5), "", "![stability map](stability_map.png)", ""]
     lines += ["![root locus](root_locus.png)", ""]
+    if shapes:
+        lines += ["Mode shapes on the plan view (each body displaced by the mode's lateral motion and turned by its "
+                  "yaw, names from the shapes: `railopt.models.mode_names`):", "", *shapes, ""]
     return "\n".join(lines)
+
+
+def sensitivity_pivot(sens: pd.DataFrame) -> pd.DataFrame:
+    """Critical speed (m/s) per parameter and factor (rows, in the order the study lists them) and model (columns,
+    in the study's order); a factor listed twice for one parameter is one row."""
+    keys = sens[["parameter", "factor"]].drop_duplicates().reset_index(drop=True)
+    for model in dict.fromkeys(sens["model"]):
+        rows = sens[sens["model"] == model].drop_duplicates(["parameter", "factor"])
+        keys = keys.merge(rows[["parameter", "factor", "critical_speed_m_s"]].rename(
+            columns={"critical_speed_m_s": model}), on=["parameter", "factor"], how="left")
+    return keys
+
+
+def _slug(label: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in label)
 
 
 def _track_effect_sentences(effect: pd.DataFrame, sens: pd.DataFrame) -> list[str]:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
@@ -13,17 +15,21 @@ __all__ = ["plot_stability_map"]
 STYLES = (("C0", "-"), ("C1", "--"), ("C2", "-."), ("C3", ":"), ("C4", "-"), ("C5", "--"))
 
 
-def plot_stability_map(damping: pd.DataFrame, maps: pd.DataFrame, title: str) -> Figure:
+def plot_stability_map(damping: pd.DataFrame, maps: pd.DataFrame, title: str,
+                       vehicles: Mapping[str, str] | None = None) -> Figure:
     """One panel per model: max Re s (1/s) of the locus grid (``damping``: model, speed_m_s, spectral_abscissa)
     against speed (m/s), each unstable interval of the certified map (``maps``: model, start_m_s, end_m_s, state)
-    shaded and every crossing speed marked by a vertical line with its value."""
+    shaded and every crossing speed marked by a vertical line with its value.  ``vehicles`` (model → the vehicle's
+    name and file, :func:`~railopt.studies.output.figures.vehicle_label`) name each panel's vehicle."""
     models = list(dict.fromkeys(damping["model"]))
     fig = Figure(figsize=(7.0, 1.9 * len(models) + 0.9))
     axes = np.atleast_1d(fig.subplots(len(models), 1, sharex=True))
     for k, (ax, model) in enumerate(zip(axes, models, strict=True)):
         d = damping[damping["model"] == model]
         colour, style = STYLES[k % len(STYLES)]
-        ax.plot(d["speed_m_s"], d["spectral_abscissa"], color=colour, ls=style, lw=1.3, label=f"{model}: max Re s")
+        vehicle = (vehicles or {}).get(model, "")
+        ax.plot(d["speed_m_s"], d["spectral_abscissa"], color=colour, ls=style, lw=1.3,
+                label=f"{model}{f' ({vehicle})' if vehicle else ''}: max Re s")
         ax.axhline(0.0, color="k", lw=0.6)
         m = maps[maps["model"] == model]
         for _, iv in m[m["state"] == "unstable"].iterrows():

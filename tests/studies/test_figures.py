@@ -74,7 +74,7 @@ def test_frf_title_is_wrapped_inside_the_figure():
     fig = frf_panel(["ref", "exact"])
     ax = fig.axes[0]
     assert "\n" in ax.get_title()
-    assert ax.get_title().replace("\n", " ") == LONG
+    assert ax.get_title().replace("\n", " ") == LONG.removeprefix("sd40-2: ")  # the vehicle named once
     texts_inside(fig)
 
 
@@ -191,7 +191,7 @@ def test_root_locus_is_damping_and_frequency_against_speed(flexible_locus):
     loci = {"before": flexible_locus, "after": flexible_locus.assign(damping_ratio=flexible_locus["damping_ratio"])}
     fig = plot_root_loci_before_after(loci, LONG)
     ax_z, ax_f = fig.axes
-    assert ax_z.get_ylabel() == "damping ratio ζ = −Re s / |s|"
+    assert ax_z.get_ylabel().startswith("damping ratio ζ = −Re s / |s|")
     assert ax_f.get_ylabel() == "frequency |Im s| / 2π (Hz)"
     assert ax_f.get_xlabel() == "forward speed (m/s)"
     assert ax_z.get_shared_x_axes().joined(ax_z, ax_f)
