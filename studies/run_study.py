@@ -55,11 +55,16 @@ def resolve_study(arg: str) -> Path:
 
 
 def run_timing(compute_s: float, report_s: float, context: StudyContext) -> pd.DataFrame:
-    """One row: how long the run's compute and report took (s), whether it resumed stored work, and where it ran
-    (``timing.csv`` of every study)."""
+    """One row: how long the run's compute and report took (s), whether it resumed stored work, where it ran, and
+    what the cluster did meanwhile (workers at the start and end, lost workers, re-run tasks: ``timing.csv`` of every
+    study)."""
+    from railopt.design.parallel import cluster_summary
+
     where = "; ".join(context.executed_on) or "serial"  # what the run really used (kinds without dask: serial)
     return pd.DataFrame([{"compute_s": compute_s, "report_s": report_s, "total_s": compute_s + report_s,
                           "resumed": bool(context.resume), "cpus": os.cpu_count(), "workers": where,
+                          # the workers at the start, at the end and the most seen; lost workers, re-run tasks
+                          **cluster_summary(context.clusters),
                           "machine": platform.machine(), "python": platform.python_version()}])
 
 
@@ -76,7 +81,8 @@ class StudyRun:
         ``study.toml`` and, for campaigns, ``campaigns/<label>.sqlite``.
     tables : dict of str to DataFrame
         Every table the study wrote, by file stem (``"peaks"`` for ``peaks.csv``; ``"timing"`` included): the
-        frames as written, so each equals its CSV read back (full precision).
+        frames as written: ``frame.to_csv(index=False)`` is the file, and its numeric columns read back equal
+        to the last bit (a column mixing text and numbers keeps its numbers here, where the CSV has text).
     figures : dict of str to Path
         Every figure, by file stem (``"frf"`` → ``folder / "frf.png"``).
     summary : str
@@ -236,7 +242,7 @@ def run_study(path: str | Path, *, results: str | Path | None = None, workers: i
     Returns
     -------
     StudyRun
-        ``tables`` (stem → DataFrame, equal to the CSV files), ``figures`` (stem → PNG path), ``summary``
+        ``tables`` (stem → DataFrame, as written to the CSV files), ``figures`` (stem → PNG path), ``summary``
         (Markdown), ``table`` (the printed short table), ``folder``, ``result`` (the kind's data object).
 
     Raises
