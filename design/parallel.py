@@ -42,6 +42,7 @@ import time
 import weakref
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any
@@ -287,6 +288,25 @@ def check_picklable(obj: Any, name: str = "") -> None:
                          "(without open files, locks or connections) or use workers=0 (serial)")
 
 
+# ---------------------------------------------------------------------- progress
+ProgressCallback = Callable[[int, int], None]
+"""``progress(done, total)``: called with ``done = 0`` when a map begins, then after every finished task."""
+
+_PROGRESS: ContextVar[ProgressCallback | None] = ContextVar("railopt_design_progress", default=None)
+
+
+@contextmanager
+def reporting_progress(progress: ProgressCallback | None) -> Iterator[None]:
+    """Within the block, every :func:`map_unordered` called without its own ``progress`` reports to ``progress``
+    (``None``: to nothing): long work made of many maps (trade-off sweeps, objective surfaces, checks) shows
+    progress without each caller passing a callback down.  Each map calls ``progress(0, total)`` when it begins."""
+    token = _PROGRESS.set(progress)
+    try:
+        yield
+    finally:
+        _PROGRESS.reset(token)
+
+
 # ---------------------------------------------------------------------- mapping
 def map_unordered(
     fn: Callable[[Any], Any],
@@ -294,6 +314,7 @@ def map_unordered(
     client: Runner | None = None,
     retries: int = 3,
     on_lost: Callable[[Any, WorkerLost], Any] | None = None,
+    progress: ProgressCallback | None = None,
 ) -> Iterator[Any]:
     """Yield ``fn(item)`` for each item, in completion order; serial when ``client`` is None.
 
@@ -309,6 +330,9 @@ def map_unordered(
         the scheduler (``distributed.scheduler.allowed-failures``).
     on_lost : callable(item, WorkerLost), optional
         Makes the result of a task that killed every worker it ran on; ``None``: raise :class:`WorkerLost`.
+    progress : callable(done, total), optional
+        Called with 0 when the map begins and after each finished task; default: the one of the enclosing
+        :func:`reporting_progress` block, if any.
 
     Raises
     ------
@@ -320,6 +344,19 @@ def map_unordered(
         Without ``on_lost``, for a task that killed its workers.
     """
     items = list(items)
+    report = progress if progress is not None else _PROGRESS.get()
+    if report is None:
+        yield from _map(fn, items, client, retries, on_lost)
+        return
+    report(0, len(items))
+    for done, result in enumerate(_map(fn, items, client, retries, on_lost), start=1):
+        report(done, len(items))
+        yield result
+
+
+def _map(fn: Callable[[Any], Any], items: list[Any], client: Runner | None, retries: int,
+         on_lost: Callable[[Any, WorkerLost], Any] | None) -> Iterator[Any]:
+    """:func:`map_unordered` without progress."""
     task = _SingleThreaded(fn)
     if client is None:
         for item in items:
@@ -668,6 +705,7 @@ def _unblock_sigint(previous: set[int] | None) -> None:
 
 __all__ = [
     "DASK_LOGS_ENV", "DEFAULT_SCHEDULER_TIMEOUT", "LOCAL_NO_WORKERS_LIMIT", "SCHEDULER_ENV", "SCHEDULER_MARGIN",
-    "SCHEDULER_TIMEOUT_ENV", "ClusterRecord", "SchedulerError", "WorkerLost", "call", "check_picklable",
-    "cluster_record", "cluster_summary", "dask_client", "map_unordered", "scheduler_timeout",
+    "SCHEDULER_TIMEOUT_ENV", "ClusterRecord", "ProgressCallback", "SchedulerError", "WorkerLost", "call",
+    "check_picklable", "cluster_record", "cluster_summary", "dask_client", "map_unordered", "reporting_progress",
+    "scheduler_timeout",
 ]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import call, check_picklable, map_unordered
+from railopt.design.parallel import ProgressCallback, call, check_picklable, map_unordered
 from railopt.design.problem import MinimaxProblem
 from railopt.design.runner import Runner
 from railopt.records import ArrayRecord
@@ -76,9 +76,10 @@ class _Value:
 
 def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], names: tuple[str, str],
              xi: Sequence[float], xj: Sequence[float], base: Sequence[float],
-             client: Runner | None = None) -> np.ndarray:
+             client: Runner | None = None, progress: ProgressCallback | None = None) -> np.ndarray:
     """``fn(x)`` on the grid ``xi × xj`` of the two named variables (the others at ``base``), one task per grid
-    row: an array (len(xj), len(xi), …) — ``fn`` may return a number or a vector."""
+    row: an array (len(xj), len(xi), …) — ``fn`` may return a number or a vector.  ``progress(done, total)``
+    counts finished rows (default: the enclosing :func:`~railopt.design.parallel.reporting_progress`)."""
     space_names = list(space_names)
     for n in names:
         if n not in space_names:
@@ -92,7 +93,8 @@ def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], nam
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
     if client is not None:
         check_picklable(fn)  # named from fn's own fields (e.g. problem.functions), not the row task's
-    rows = dict(map_unordered(call, [_Row(fn, base, i, j, xi, float(v)) for v in xj], client=client))
+    rows = dict(map_unordered(call, [_Row(fn, base, i, j, xi, float(v)) for v in xj], client=client,
+                              progress=progress))
     return np.array([rows[float(v)] for v in xj])
 
 
@@ -103,10 +105,12 @@ def objective_surface(
     xj: Sequence[float],
     base: Sequence[float],
     client: Runner | None = None,
+    progress: ProgressCallback | None = None,
 ) -> Surface:
-    """U over ``xi × xj`` for the two named variables, the others at ``base``; one task per grid row."""
+    """U over ``xi × xj`` for the two named variables, the others at ``base``; one task per grid row
+    (``progress(done, total)`` in rows, as :func:`grid_map`)."""
     space = problem.space
-    values = grid_map(_Value(problem), space.names, names, xi, xj, base, client)
+    values = grid_map(_Value(problem), space.names, names, xi, xj, base, client, progress)
     i, j = space.names.index(names[0]), space.names.index(names[1])
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
     inside_i = (xi >= space.lower[i]) & (xi <= space.upper[i])

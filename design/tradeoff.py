@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import call, map_unordered
+from railopt.design.parallel import ProgressCallback, call, map_unordered
 from railopt.design.problem import MinimaxProblem
 from railopt.design.runner import Runner
 from railopt.design.solve import method_options, solve
@@ -64,11 +64,14 @@ def epsilon_sweep(
     points: Sequence[Sequence[float]] | None = None,
     client: Runner | None = None,
     options: dict[str, Any] | None = None,
+    progress: ProgressCallback | None = None,
 ) -> pd.DataFrame:
     """Minimise U s.t. g(x) ≤ ε for each ε (the problem's single constraint), multi-start each.
 
     Returns one row per ε: ``epsilon, value, g, status, success, <variables>…`` for the best
-    feasible start (``success`` False and NaN values when no start was feasible).
+    feasible start (``success`` False and NaN values when no start was feasible).  ``progress(done, total)``
+    counts finished solves (ε × starts; default: the enclosing
+    :func:`~railopt.design.parallel.reporting_progress`).
     """
     if not problem.has_constraints:
         raise ValueError("problem: an ε-constraint sweep needs a problem with constraints g(x)")
@@ -79,7 +82,7 @@ def epsilon_sweep(
     starts = start_points(problem.space, n_starts, seed=seed, points=points)
     tasks = [_SweepTask(problem, e, s.x0, method, dict(options or {})) for e in eps for s in starts]
     best: dict[float, Any] = {}
-    for e, r in map_unordered(call, tasks, client=client):
+    for e, r in map_unordered(call, tasks, client=client, progress=progress):
         if r.feasible and np.isfinite(r.value) and (e not in best or r.value < best[e].value):
             best[e] = r
     rows = []

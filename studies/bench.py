@@ -17,8 +17,9 @@
 7. Stability constraints with gradients against one eig(G) per speed; the random-response RMS by quadrature
    against the modal Lyapunov covariance at equal accuracy.
 
-Timings are medians of repeated runs (``time.perf_counter``); results go to
-``results/benchmarks/bench.csv`` and ``bench.md``.
+Timings are medians of repeated runs (``time.perf_counter``); results go to ``bench.csv`` and ``bench.md`` in
+``--out`` (default ``runs/benchmarks/``; the committed rows: ``railopt bench --out results/benchmarks``), the full
+campaign's row read from the ``timing.csv`` of ``cab_lateral_minimax_campaign`` beside that folder.
 """
 
 from __future__ import annotations

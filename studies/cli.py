@@ -17,6 +17,9 @@ scheduler — ends as one line on stderr naming the file, field or address, and 
 from __future__ import annotations
 
 import argparse
+import math
+import os
+import select
 import signal
 import sqlite3
 import sys
@@ -29,11 +32,11 @@ from railopt.design.parallel import SCHEDULER_TIMEOUT_ENV, scheduler_timeout
 from railopt.studies.config import ConfigError, load_study, read_toml
 from railopt.studies.kind import StudyKind
 from railopt.studies.output.markdown import markdown_table
-from railopt.studies.output.publish import ResultsError
+from railopt.studies.output.publish import ResultsError, check_writable, ensure_folder, results_root
 from railopt.studies.run_study import STUDIES_DIR, execute_study, resolve_study, run_timing
 
 __all__ = [
-    "STUDIES_DIR", "build_parser", "cmd_bench", "cmd_list", "cmd_reference", "cmd_run", "cmd_validate",
+    "STUDIES_DIR", "build_parser", "check_number", "cmd_bench", "cmd_list", "cmd_reference", "cmd_run", "cmd_validate",
     "cmd_vehicle", "main", "main_vehicle", "print_warnings", "resolve_study", "run_timing",
 ]
 
@@ -41,6 +44,10 @@ EXIT_USAGE = 2
 EXIT_FAILED = 1
 EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143
+EXIT_PIPE = 141  # 128 + SIGPIPE: what a shell reports for a tool whose reader went away (`seq 1 1e6 | head -1`)
+RESULTS_DEFAULT = "runs"  # a user's runs: git-ignored; the committed reference outputs are under results/
+MAX_SPEED_M_S = 1000.0  # above any rail vehicle's speed: a larger --speed is a slip (or 1e308), refused by name
+WORKERS_PER_CPU = 16  # --workers above this many per CPU is a slip: each worker is a process
 
 
 def print_warnings(kind: StudyKind, config: object, study_file: Path | str) -> list[str]:
@@ -51,9 +58,32 @@ def print_warnings(kind: StudyKind, config: object, study_file: Path | str) -> l
     return messages
 
 
+def check_number(value: float | None, flag: str, lowest: float, highest: float, *, above: bool = False,
+                 unit: str = "") -> float | None:
+    """A command-line number (``None`` passes): finite and within [``lowest``, ``highest``] (``above``: strictly
+    above ``lowest``), else a :class:`ConfigError` naming ``flag``, the range and the value.  argparse reads
+    ``1e308``, ``inf`` and ``nan`` as floats: they are refused here, before any work."""
+    if value is None:
+        return None
+    low_ok = value > lowest if above else value >= lowest
+    if not (math.isfinite(value) and low_ok and value <= highest):
+        bound = f"{'>' if above else '≥'} {lowest:g}"
+        raise ConfigError(f"{flag}: must be a finite number {bound} and ≤ {highest:g}{unit}, got {value!r}")
+    return value
+
+
+def _max_workers() -> int:
+    return WORKERS_PER_CPU * (os.cpu_count() or 1)
+
+
+def _check_workers(workers: int | None, flag: str = "--workers", lowest: int = 0) -> None:
+    if workers is not None and not lowest <= workers <= _max_workers():
+        raise ConfigError(f"{flag}: must be {lowest} to {_max_workers()} ({WORKERS_PER_CPU} per CPU of this machine: "
+                          f"each worker is a process), got {workers}")
+
+
 def _check_flags(args: argparse.Namespace) -> None:
-    if args.workers is not None and args.workers < 0:
-        raise ConfigError(f"--workers: must be ≥ 0, got {args.workers}")
+    _check_workers(args.workers)
     if args.workers is not None and args.scheduler:
         raise ConfigError("--workers and --scheduler: give one of them (a local cluster or an existing scheduler)")
     if args.scheduler_timeout is not None:
@@ -74,9 +104,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     kind, config, _ = load_study(study_file)
     _check_flags(args)
     print_warnings(kind, config, study_file)
-    done = execute_study(study_file, kind, config, Path(args.results), fresh=args.fresh, resume=args.resume,
+    done = execute_study(study_file, kind, config, args.results, fresh=args.fresh, resume=args.resume,
                          workers=args.workers, scheduler=args.scheduler, scheduler_timeout=args.scheduler_timeout,
                          retry_failed=args.retry_failed, show_progress=not args.no_progress)
+    events = done.tables["timing"]["cluster_events"] if "cluster_events" in done.tables["timing"] else []
+    for text in (t for t in events if isinstance(t, str) and t):
+        print(f"railopt: note: {text}", file=sys.stderr)  # a lost worker, and the tasks re-run elsewhere
     name, final = done.name, done.folder
     with_pd_options = done.table.to_string(index=False, float_format=lambda v: f"{v:.7g}")
     print(f"\n{name}: {kind.summary}\n")
@@ -177,6 +210,7 @@ def main_vehicle(argv: Sequence[str]) -> tuple[str, int]:
     except SystemExit:  # --help
         return parser.format_help(), 0
     try:
+        check_number(args.speed, "--speed", 0.0, MAX_SPEED_M_S, above=True, unit=" m/s")
         vehicle = load_vehicle(args.vehicle)
         summary = vehicle_summary(vehicle, speed=args.speed, track=args.track)
         drawn = None if args.modes is None else write_mode_figure(vehicle, summary.speed, args.track, args.modes)
@@ -199,7 +233,7 @@ def cmd_reference(args: argparse.Namespace) -> int:
     if args.out is None:
         sys.stdout.write(text)
         return 0
-    out = Path(args.out)
+    out = results_root(args.out, "--out")
     try:
         out.write_text(text)
     except OSError as exc:
@@ -209,10 +243,18 @@ def cmd_reference(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    """``railopt bench``: the benchmark rows as ratios, written to ``results/benchmarks/``."""
+    """``railopt bench``: the benchmark rows as ratios, written to ``--out`` (default ``runs/benchmarks/``; the
+    committed rows are ``results/benchmarks/``, written with ``--out results/benchmarks``).  The folder is checked
+    before the benchmarks run (minutes), not when they are written."""
+    _check_workers(args.workers, lowest=1)
+    out = ensure_folder(results_root(args.out, "--out"), "--out")
+    for name in ("bench.csv", "bench.md"):
+        if (out / name).exists() and not (out / name).is_file():
+            raise ResultsError(f"--out: {out / name} is in the way (not a file); move it away or choose another --out")
+    check_writable(out, flag="--out")
     from railopt.studies.bench import run_bench
 
-    run_bench(Path(args.out), workers=args.workers, quick=args.quick)
+    run_bench(out, workers=args.workers, quick=args.quick)
     return 0
 
 
@@ -237,7 +279,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="with --resume: run again the starts stored as worker_lost (a start that killed its worker)")
     stores.add_argument("--fresh", action="store_true",
                         help="start new campaign stores; the old ones are discarded when this run is published")
-    run.add_argument("--results", default="results", help="results root folder (default: ./results)")
+    run.add_argument("--results", default=RESULTS_DEFAULT,
+                     help=f"results root folder (default: ./{RESULTS_DEFAULT}, git-ignored; the committed reference "
+                          "outputs are regenerated with --results results)")
     run.add_argument("--no-progress", action="store_true", help="no progress bars")
     run.set_defaults(func=cmd_run)
 
@@ -258,9 +302,11 @@ def build_parser() -> argparse.ArgumentParser:
     ref.add_argument("--out", default=None, help="write it to this file (default: stdout)")
     ref.set_defaults(func=cmd_reference)
 
-    bench = sub.add_parser("bench", help="benchmarks, printed as ratios; written to results/benchmarks/")
-    bench.add_argument("--out", default="results/benchmarks")
-    bench.add_argument("--workers", type=int, default=2)
+    bench = sub.add_parser("bench", help=f"benchmarks, printed as ratios; written to {RESULTS_DEFAULT}/benchmarks/")
+    bench.add_argument("--out", default=f"{RESULTS_DEFAULT}/benchmarks",
+                       help=f"folder of bench.csv and bench.md (default: ./{RESULTS_DEFAULT}/benchmarks; the committed "
+                            "rows: --out results/benchmarks)")
+    bench.add_argument("--workers", type=int, default=2, help="dask workers of the cluster benchmarks (default 2)")
     bench.add_argument("--quick", action="store_true", help="fewer repetitions")
     bench.set_defaults(func=cmd_bench)
     return parser
@@ -277,8 +323,43 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(text.split())
 
 
+def _pipe_closed(stream: object) -> bool:
+    """Whether ``stream`` is a pipe (or socket) whose reader has gone away (``railopt vehicle sd40-2 | head -1``)."""
+    try:
+        fd = stream.fileno()  # type: ignore[attr-defined]
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
+        return any(events & (select.POLLERR | select.POLLHUP) for _, events in poller.poll(0))
+    except (AttributeError, ValueError, OSError):  # no file behind it (a test's capture), or closed
+        return False
+
+
+def _quiet_exit() -> int:
+    """The reader of stdout went away: no message (it is not an error), and no second failure when Python flushes
+    stdout at exit; :data:`EXIT_PIPE`, as a tool ended by SIGPIPE."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (AttributeError, ValueError, OSError):
+        pass
+    return EXIT_PIPE
+
+
 def main(argv: list[str] | None = None) -> int:
-    """The ``railopt`` entry point: returns the exit code (0, or 2 with one ``railopt: error:`` line)."""
+    """The ``railopt`` entry point: returns the exit code (0, or 2 with one ``railopt: error:`` line; 130 after
+    Ctrl-C, 143 after SIGTERM; 141, silently, when the reader of the output went away, e.g. ``| head -1``)."""
+    try:
+        code = _main(argv)
+        sys.stdout.flush()  # a closed pipe shows here, not as "Exception ignored" at exit
+        return code
+    except BrokenPipeError:
+        if _pipe_closed(sys.stdout) or _pipe_closed(sys.stderr):
+            return _quiet_exit()
+        raise
+
+
+def _main(argv: list[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["vehicle"]:  # its own options (--speed, --help) go to the vehicle hook, in any order
         args = argparse.Namespace(command="vehicle", func=cmd_vehicle, argv=argv[1:])
@@ -288,15 +369,22 @@ def main(argv: list[str] | None = None) -> int:
     previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
     try:
         return args.func(args)
+    except BrokenPipeError as exc:  # the reader of our output went away: quiet; any other broken pipe is an error
+        if _pipe_closed(sys.stdout) or _pipe_closed(sys.stderr):
+            return _quiet_exit()
+        print(f"railopt: error: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_USAGE
     except (ValueError, OSError, ResultsError, sqlite3.Error) as exc:  # config, store, results folder, scheduler
         print(f"railopt: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt as exc:
-        if getattr(args, "fresh", False):
-            kept = "the previous results and campaign stores are unchanged (this --fresh run's starts are discarded)"
+        if args.command != "run":
+            kept = ""
+        elif getattr(args, "fresh", False):
+            kept = "; the previous results and campaign stores are unchanged (this --fresh run's starts are discarded)"
         else:
-            kept = "finished starts are kept in the campaign store; rerun with --resume"
-        print(f"railopt: interrupted; {kept}", file=sys.stderr)
+            kept = "; finished starts are kept in the campaign store; rerun with --resume"
+        print(f"railopt: interrupted{kept}", file=sys.stderr)
         return EXIT_TERMINATED if isinstance(exc, _Terminated) else EXIT_INTERRUPTED
     finally:
         if in_main_thread:

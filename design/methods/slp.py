@@ -11,6 +11,10 @@ equations", J. Inst. Maths Applics 16 (1975) 321-328).
 
 from __future__ import annotations
 
+import ctypes
+import functools
+import os
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -18,6 +22,27 @@ from typing import Any
 import numpy as np
 
 from railopt.design.methods.base import BIG, EpigraphView, Outcome, StopSolve, register
+
+
+@functools.cache
+def _quiet_highs() -> None:
+    """HiGHS prints a copyright banner to stdout (file descriptor 1, from C) the first time a process makes a solver,
+    whatever cvxpy's ``verbose`` says: once per dask worker, in the middle of a run's output.  Make that first
+    solver here with descriptor 1 pointed at /dev/null, once per process."""
+    try:
+        import highspy
+    except ImportError:  # another LP solver: nothing to silence
+        return
+    sys.stdout.flush()
+    saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        highspy.Highs()
+        ctypes.CDLL(None).fflush(None)  # what C buffered goes to /dev/null too
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
 
 
 def _merit(f: np.ndarray, g: np.ndarray, penalty: float) -> float:
@@ -46,6 +71,8 @@ class SLPMethod:
         """
         import cvxpy as cp
 
+        if str(options["lp_solver"]).upper() == "HIGHS":
+            _quiet_highs()
         d = view.space.dim
         m = view.problem.n_functions
         p = view.problem.n_constraints or 0  # counted at the view's first evaluation

@@ -41,6 +41,7 @@ from railopt.studies.config import BandHz, FiniteModel
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_frf_panels
 from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.progress import Progress
 from railopt.studies.output.records import FrfPanel
 from railopt.studies.output.writer import Writer
 from railopt.studies.specs import CampaignSettings, SpectrumSpec, VariableSpec
@@ -207,8 +208,13 @@ def compute(config: RideStudyConfig, context: StudyContext) -> RideResult:
         designs = {"existing": (existing, True)}
         for label, target in (("minimax_sinusoid", sin_target), ("rms_random", rms_target)):
             problem = minimax_problem(setup, variables, target)
-            table = multistart(problem, settings.n_starts, method=settings.method, seed=settings.seed,
-                               sampler=settings.sampler, points=start, options=settings.solver_options())
+            bar = Progress(f"{case.label} {label}", unit="start", enabled=context.show_progress)
+            try:
+                table = multistart(problem, settings.n_starts, method=settings.method, seed=settings.seed,
+                                   sampler=settings.sampler, points=start, options=settings.solver_options(),
+                                   progress=bar.update)
+            finally:
+                bar.close()
             starts.append(table.drop(columns=["functions"], errors="ignore").assign(case=case.label,
                                                                                     criterion=label))
             designs[label] = _optimum(table, names)

@@ -71,7 +71,7 @@ def test_vehicle_summary_numbers_match_the_text_and_the_model_layer(tutorial):
 
 def test_study_critical_speeds_match_the_text_and_the_model_layer(tutorial):
     folder, done = tutorial
-    table = pd.read_csv(folder / "results" / "two_axle_car" / "critical_speeds.csv").set_index("model")
+    table = pd.read_csv(folder / "runs" / "two_axle_car" / "critical_speeds.csv").set_index("model")
     vehicle = load_vehicle(str(folder / "car.toml"))
     direct = critical_speed(vehicle.lateral(track="rigid"), speed_range=(5.0, 150.0), tol=0.01, grid=16)
     assert table.loc["car", "critical_speed_m_s"] == pytest.approx(direct.speed, abs=1e-9)
@@ -84,7 +84,7 @@ def test_study_critical_speeds_match_the_text_and_the_model_layer(tutorial):
         speed = table.loc[model, "critical_speed_m_s"]
         hz = table.loc[model, "hunting_frequency_hz"]
         assert f"| {model} | {speed:.2f} m/s | {hz:.2f} Hz |" in text
-    sens = pd.read_csv(folder / "results" / "two_axle_car" / "sensitivity.csv")
+    sens = pd.read_csv(folder / "runs" / "two_axle_car" / "sensitivity.csv")
     car = sens[(sens["model"] == "car") & (sens["parameter"] == "conicity")].set_index("factor")
     assert f"at half the conicity the car hunts at {car.loc[0.5, 'critical_speed_m_s']:.2f} m/s" in text
     assert f"at twice\nthe conicity at {car.loc[2.0, 'critical_speed_m_s']:.2f} m/s" in text

@@ -13,12 +13,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from railopt.design.parallel import reporting_progress
 from railopt.studies.kind import StudyContext, dask_context
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
 from railopt.studies.kinds.campaign.problems import _p, campaign_label
 from railopt.studies.kinds.campaign.sections import ModelSections, _comparison_row, _frf_panels, _model_sections, _short
 from railopt.studies.kinds.campaign.selection import _recommend
 from railopt.studies.kinds.campaign.stores import _campaign, check_stores
+from railopt.studies.output.progress import Progress
 
 __all__ = ["CampaignResult", "compute", "warnings"]
 
@@ -78,9 +80,12 @@ def compute(config: CampaignStudyConfig, context: StudyContext) -> CampaignResul
         recommended = {m: _recommend(cfg, s, m, optima, flags, cfg.design.problems[0]) for m, s in setups.items()}
         sections = []
         if cfg.report.before or cfg.tradeoffs or cfg.surfaces or any(recommended.values()):
-            sections = [_model_sections(cfg, m, s, comparison, tables, "" if len(setups) == 1 else f"_{m}", client,
-                                        recommended[m])
-                        for m, s in setups.items()]
+            for m, s in setups.items():  # trade-off sweeps and surfaces: many maps, one progress line for them all
+                bar = Progress(f"{m}: trade-offs, surfaces and checks", unit="task", enabled=context.show_progress)
+                with reporting_progress(bar.over_maps()):
+                    sections.append(_model_sections(cfg, m, s, comparison, tables,
+                                                    "" if len(setups) == 1 else f"_{m}", client, recommended[m]))
+                bar.close()
     starts = pd.concat([t.drop(columns=["functions"], errors="ignore").assign(model=m, problem=prob, objective=o,
                                                                              method=meth)
                         for (m, prob, o, meth), t in tables.items()], ignore_index=True)

@@ -23,10 +23,12 @@ import numpy as np
 import pandas as pd
 
 from railopt.design import CampaignStore, MinimaxProblem, check_designs, distinct_optima, multistart, start_points
+from railopt.design.parallel import reporting_progress
 from railopt.studies.catalog import Check, ModelSetup
 from railopt.studies.kind import StudyContext
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
 from railopt.studies.kinds.campaign.problems import _starts, campaign_label, campaign_problem
+from railopt.studies.output.progress import Progress  # a bar on a terminal, plain periodic lines in a log
 from railopt.studies.specs import CampaignSettings
 
 __all__ = ["check_optima", "check_stores", "input_digests", "input_files", "run_campaign", "store_path"]
@@ -161,8 +163,6 @@ def run_campaign(
         store = CampaignStore.create(path, label, config, list(problem.space.names))
     else:
         store = CampaignStore.open(path, expect_config=config)
-    from railopt.studies.output.progress import Progress  # a bar on a terminal, plain periodic lines in a log
-
     bar = Progress(label, unit="start", enabled=context.show_progress)
     discard = False
     try:
@@ -256,7 +256,10 @@ def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, 
     table = run_campaign(problem, label, settings, context, store_config, client, _starts(cfg, setup))
     found = distinct_optima(table, problem).rename(columns={"best_start": "start_id"})
     flags: list[str] = []
-    for check in cfg.design.checks:
-        found, check_flags = check_optima(found, setup, names, label, context, check, client)
+    for check in cfg.design.checks:  # a check of each distinct optimum (a critical-speed search: seconds each)
+        bar = Progress(f"{label}: {check} check of the optima", unit="design", enabled=context.show_progress)
+        with reporting_progress(bar.update):
+            found, check_flags = check_optima(found, setup, names, label, context, check, client)
+        bar.close()
         flags += check_flags
     return table, found, flags
