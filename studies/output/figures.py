@@ -51,10 +51,13 @@ def _scales(units: str) -> tuple[float, str, float, str]:
 
 
 def _caption(fig: Figure, note: str) -> None:
-    """Parameters as a caption under the axes."""
+    """Parameters as a caption under the axes, wrapped to the figure's width, the axes raised above it."""
     if note:
-        fig.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=7, color="0.3")
-        fig.tight_layout(rect=(0.0, 0.07, 1.0, 1.0))
+        width, height = fig.get_size_inches()
+        text = wrap_title(note, width - 0.4, 7)
+        fig.text(0.5, 0.01, text, ha="center", va="bottom", fontsize=7, color="0.3")
+        room = 0.02 + (text.count("\n") + 1) * 7 * 1.3 / 72 / height
+        fig.tight_layout(rect=(0.0, max(0.07, room), 1.0, 1.0))
     else:
         fig.tight_layout()
 
