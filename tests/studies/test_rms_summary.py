@@ -231,5 +231,5 @@ def test_a_side_measure_that_got_worse_is_flagged_in_the_tables_and_the_summary(
     assert bool(ba["peak_worse"]) and ba["peak_change"] == pytest.approx(after / before - 1, rel=1e-9)
     summary = (out / "summary.md").read_text()
     signed = f"+{100 * (after / before - 1):.3g} % (WORSE)"
-    assert f"**Side measure worse after optimisation:** certified peak of {SEAT} ({signed})" in summary
+    assert f"**Side measure worse after optimisation:** certified peak of {SEAT}: {signed}" in summary
     assert f"| … its change against existing |  | {signed} |" in summary

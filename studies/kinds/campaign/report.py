@@ -181,12 +181,12 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
           markdown_table(ba.table, digits=5), ""]
     if len(worse):
         md += ["**Worse after optimisation:** " + ", ".join(
-            f"{r['output']} ({_signed(r['change'], True)})" for _, r in worse.iterrows())
-               + " — only the objective output was minimised; the others are shown, not optimised.", ""]
+            f"{r['output']}: {_signed(r['change'], True)}" for _, r in worse.iterrows())
+               + "; only the objective output was minimised, the others are shown, not optimised.", ""]
     if len(side_worse):
         md += ["**Side measure worse after optimisation:** certified peak of " + ", ".join(
-            f"{r['output']} ({_signed(r['peak_change'], True)})" for _, r in side_worse.iterrows())
-               + " — the RMS was minimised, not the sinusoid peak.", ""]
+            f"{r['output']}: {_signed(r['peak_change'], True)}" for _, r in side_worse.iterrows())
+               + "; the RMS was minimised, not the sinusoid peak.", ""]
     md += [f"Active bounds at the optimum: {', '.join(ba.active) if ba.active else 'none'}. The thesis approximation "
            f"(4.71)–(4.73) reads {ba.thesis:.5g} at this optimum against the certified maximum {ba.exact:.5g} "
            f"({100 * (ba.thesis - ba.exact) / ba.exact:+.2f} %).", ""]
