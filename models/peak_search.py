@@ -1,11 +1,15 @@
-"""One peak search for the whole model layer: grid → best sample per cell → golden-section refine.
+"""One peak search for the whole model layer: grid → candidate samples per cell → bracketed refine.
 
 Used for the certified band maximum of a frequency response (:mod:`railopt.models.response_maxima`),
 the maximum of a moving-load deflection profile (:mod:`railopt.models.track.moving_load`) and the
 closed-form TMD peak (:mod:`railopt.models.tmd`).  The caller owns the grid (its resolution is
-what makes the result trustworthy); this module only finds, in each cell, the best sample and
-refines it between that sample's neighbours (parabolic interpolation safeguarded by golden
-section), vectorised across cells.
+what makes the result trustworthy); this module finds, in each cell, every sampled local maximum
+that could hold the cell's true maximum — those within :data:`CANDIDATE_MARGIN` of the cell's best
+sample, since a resolved peak is sampled within a few per cent of its top — and refines each between
+its grid neighbours (parabolic steps safeguarded by Brent's method), vectorised across candidates.
+Refining the best sample alone is not enough: many nearly equal lobes in one cell (the interference
+of delayed inputs inside one resonance) are each sampled a little below their tops, and the best
+sample need not sit on the highest lobe.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ INV_PHI = (np.sqrt(5.0) - 1.0) / 2.0
 BRACKET_RTOL = 1e-6  # stop when the best point is located to this fraction of its bracket (value error ~1e-13)
 MAX_ITERATIONS = 80
 SCALAR_CELLS = 12  # kept for compatibility: every cell is now refined by the one vectorised Brent
+CANDIDATE_MARGIN = 0.1  # sampled local maxima within this fraction of their cell's best sample are refined too
 
 
 def bracketed_maximum(fun: Callable[[np.ndarray], np.ndarray], lower: np.ndarray, upper: np.ndarray,
@@ -97,15 +102,18 @@ VERTEX_ITERATIONS = 12
 
 
 def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-                  rtol: float = BRACKET_RTOL, positive: bool = True) -> tuple[np.ndarray, np.ndarray]:
+                  rtol: float = BRACKET_RTOL, positive: bool = True,
+                  scale: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Maximiser of ``fun`` in each bracket ``[lower_i, upper_i]`` from its best sample ``x0_i``, all brackets at once.
 
     Newton steps on the local parabola: each step samples x ± h (one call of ``fun`` for every bracket) and moves
     to the vertex of the parabola through the three points of φ = 1/f² (``positive``; exactly a parabola near a
     resonance of one pole, see :func:`cell_maxima`) or of −f, with h a tenth of the last step (at least
     10·tol), so the steps contract superlinearly; a start within a quarter of the bracket from its ends starts
-    mid-way instead.  A bracket is done when a step is below tol (Brent's ``rtol``·width/3, as in
-    :func:`bracketed_maximum`) from a parabola fitted over at most 100·tol.  Returns ``(x, ok)``; ``ok`` is False
+    mid-way instead.  ``scale`` (one positive value per bracket, e.g. its best sample) makes φ = (scale/f)², so
+    that neither f² nor 1/f² over- or underflows for values far from 1 (a peak of 1e160 or 1e-170).  A bracket
+    is done when a step is below tol (Brent's ``rtol``·width/3, as in :func:`bracketed_maximum`) from a parabola
+    fitted over at most 100·tol.  Returns ``(x, ok)``; ``ok`` is False
     where a step would leave the bracket or the parabola is not convex (the caller refines those by Brent).
     """
     lo = np.asarray(lower, dtype=float)
@@ -118,6 +126,7 @@ def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower
     x = np.where((x - lo > quarter) & (hi - x > quarter), x, 0.5 * (lo + hi))
     live = np.flatnonzero(hi > lo)
     h = 0.5 * np.minimum(x - lo, hi - x)[live]
+    ref = np.ones(x.size) if scale is None else np.asarray(scale, dtype=float)
     for _ in range(VERTEX_ITERATIONS):
         if live.size == 0:
             break
@@ -126,7 +135,7 @@ def vertex_refine(fun: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, lower
         k = live.size
         f = fun(np.concatenate([left, xl, right]))
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            phi = 1.0 / (f * f) if positive else -f
+            phi = np.square(np.tile(ref[live], 3) / f) if positive else -f
             pl, pm, pr = phi[:k], phi[k:2 * k], phi[2 * k:]
             dl, dr = xl - left, right - xl
             num = dl * dl * (pm - pr) - dr * dr * (pm - pl)
@@ -203,8 +212,10 @@ def cell_maxima(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, value
     """Maximum of ``fun`` over each cell ``[boundaries[j], boundaries[j+1]]``.
 
     ``grid`` (sorted, containing every boundary) and ``values = fun(grid)`` are the caller's
-    samples.  In each cell the best sample is refined between its grid neighbours (clipped to the
-    cell).  A non-finite best sample (a pole hit) is returned as it is.  Returns (x, f), one per cell.
+    samples.  In each cell every sampled local maximum within :data:`CANDIDATE_MARGIN` of the cell's
+    best sample is refined between its grid neighbours (clipped to the cell), and the cell's value is
+    the best refined one (never below its best sample).  A non-finite best sample (a pole hit) is
+    returned as it is.  Returns (x, f), one per cell.
     """
     grid = np.asarray(grid, dtype=float)
     values = np.asarray(values, dtype=float)
@@ -219,39 +230,72 @@ def cell_maxima(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, value
     # the samples of every cell laid end to end (cells share their boundary samples), then one segmented
     # reduction per quantity
     counts = stop - start
-    offsets = np.zeros(len(start), dtype=np.intp)
+    n_cells = len(start)
+    offsets = np.zeros(n_cells, dtype=np.intp)
     np.cumsum(counts[:-1], out=offsets[1:])
-    members = np.arange(int(counts.sum())) + np.repeat(start - offsets, counts)
+    size = int(counts.sum())
+    members = np.arange(size) + np.repeat(start - offsets, counts)
     cell_values = masked[members]
     cell_max = np.maximum.reduceat(cell_values, offsets)
-    position = np.where(cell_values == np.repeat(cell_max, counts), np.arange(members.size), members.size)
-    best = members[np.minimum.reduceat(position, offsets)]  # first sample attaining the cell's maximum
+    top = np.repeat(cell_max, counts)
+    at_top = np.minimum.reduceat(np.where(cell_values == top, np.arange(size), size), offsets)
+    best = members[at_top]  # first sample attaining the cell's maximum
     x, f = grid[best].copy(), values[best].copy()
-    lo_cell, hi_cell = bounds[:-1], bounds[1:]
-    lo = np.maximum(grid[np.maximum(best - 1, 0)], lo_cell)
-    hi = np.minimum(grid[np.minimum(best + 1, len(grid) - 1)], hi_cell)
-    refine = np.isfinite(f) & (hi > lo)
-    # a best sample on a cell boundary is the maximum when f falls into the cell from it (no bump
+    # candidates: the cell's sampled local maxima (above the left neighbour, not below the right one, within the
+    # cell) within CANDIDATE_MARGIN of its best sample; the best sample is always one
+    left = np.empty(size)
+    left[1:], left[offsets] = cell_values[:-1], -np.inf
+    right = np.empty(size)
+    right[:-1], right[offsets + counts - 1] = cell_values[1:], -np.inf
+    with np.errstate(invalid="ignore"):  # an infinite best sample has no candidates (it is returned as it is)
+        near = cell_values >= top - CANDIDATE_MARGIN * np.abs(top)
+    candidate = near & (cell_values > left) & (cell_values >= right)
+    candidate[at_top] = True
+    candidate &= np.isfinite(cell_values) & np.isfinite(top)
+    which = np.flatnonzero(candidate)
+    if which.size == 0:
+        return x, f
+    cells = np.searchsorted(offsets, which, side="right") - 1
+    gi = members[which]
+    cx, cf = grid[gi], values[gi]
+    lo_cell, hi_cell = bounds[:-1][cells], bounds[1:][cells]
+    lo = np.maximum(grid[np.maximum(gi - 1, 0)], lo_cell)
+    hi = np.minimum(grid[np.minimum(gi + 1, len(grid) - 1)], hi_cell)
+    refine = hi > lo
+    # a candidate on a cell boundary is the maximum there when f falls into the cell from it (no bump
     # inside the first step): one probe instead of a one-sided search
-    at_lo, at_hi = refine & (x <= lo_cell), refine & (x >= hi_cell)
+    at_lo, at_hi = refine & (cx <= lo_cell), refine & (cx >= hi_cell)
     edge = np.flatnonzero(at_lo | at_hi)
     if edge.size:
         h = 1e-6 * (hi[edge] - lo[edge])
-        probe = np.where(at_lo[edge], x[edge] + h, x[edge] - h)
-        refine[edge[fun(probe) <= f[edge]]] = False
+        probe = np.where(at_lo[edge], cx[edge] + h, cx[edge] - h)
+        refine[edge[fun(probe) <= cf[edge]]] = False
     idx = np.flatnonzero(refine)
     if idx.size:
-        # −1/f² has the same maximiser as f > 0 and is exactly a parabola near a resonance of one
-        # pole (|H|² ∝ 1/((Ω−ω)² + σ²)), so the parabolic steps converge in a few iterations
+        # −(s/f)² (s: the candidate's sample) has the same maximiser as f > 0 and is exactly a parabola near a
+        # resonance of one pole (|H|² ∝ 1/((Ω−ω)² + σ²)), so the parabolic steps converge in a few iterations
         positive = bool(np.all(values[np.isfinite(values)] > 0))
-        xr, ok = vertex_refine(fun, x[idx], lo[idx], hi[idx], rtol, positive)  # every cell at once
-        if not ok.all():  # the safeguard: Brent in the cells where the local parabola did not settle
-            target = (lambda w: -1.0 / np.square(fun(w))) if positive else fun
+        ref = cf[idx] if positive else None
+        xr, ok = vertex_refine(fun, cx[idx], lo[idx], hi[idx], rtol, positive, ref)  # every candidate at once
+        if not ok.all():  # the safeguard: Brent where the local parabola did not settle (log f: scale-free)
+            def target(w: np.ndarray) -> np.ndarray:
+                with np.errstate(divide="ignore"):
+                    return np.log(fun(w)) if positive else fun(w)
+
             xr[~ok], _ = bracketed_maximum(target, lo[idx[~ok]], hi[idx[~ok]], rtol)
         fr = fun(xr)
-        better = fr > f[idx]
-        x[idx] = np.where(better, xr, x[idx])
-        f[idx] = np.where(better, fr, f[idx])
+        better = fr > cf[idx]
+        cx[idx] = np.where(better, xr, cx[idx])
+        cf[idx] = np.where(better, fr, cf[idx])
+    # each cell's best candidate (candidates are in cell order): the largest value, the first on ties
+    if which.size == n_cells:  # one candidate per cell (the usual case): it is the cell's
+        winners, pick = cells, np.arange(which.size)
+    else:
+        order = np.lexsort((-cf, cells))
+        pick = order[np.r_[True, cells[order][1:] != cells[order][:-1]]]
+        winners = cells[pick]
+    take = cf[pick] > f[winners]
+    x[winners[take]], f[winners[take]] = cx[pick][take], cf[pick][take]
     return x, f
 
 
@@ -265,6 +309,6 @@ def grid_maximum(fun: Callable[[np.ndarray], np.ndarray], grid: np.ndarray, valu
 
 
 __all__ = [
-    "BRACKET_RTOL", "INV_PHI", "MAX_ITERATIONS", "SCALAR_CELLS", "VERTEX_ITERATIONS", "bracketed_maximum",
-    "brent_maximum", "cell_maxima", "grid_maximum", "vertex_refine",
+    "BRACKET_RTOL", "CANDIDATE_MARGIN", "INV_PHI", "MAX_ITERATIONS", "SCALAR_CELLS", "VERTEX_ITERATIONS",
+    "bracketed_maximum", "brent_maximum", "cell_maxima", "grid_maximum", "vertex_refine",
 ]

@@ -48,7 +48,8 @@ MIN_CELL_SAMPLES = 8
 MAX_GRID_POINTS = 200_000
 CONSISTENCY_RTOL = 1e-6  # pole–residue vs direct value at a refined maximum; beyond it, redo by direct solves
 
-__all__ = ["ResponseMaxima", "all_response_maxima", "band_grid", "peak", "response_maxima", "validate_band"]
+__all__ = ["ResponseMaxima", "ZeroZone", "all_response_maxima", "band_grid", "peak", "response_maxima", "validate_band",
+           "zero_zone"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -187,18 +188,32 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
         freqs = np.concatenate([clipped, edges])
         return {nm: ResponseMaxima(np.full(len(freqs), np.inf), freqs, wd, (lo, hi), exact=exact, certified=False,
                                    output=nm, evaluation="unstable", reason=reason) for nm in names}
-    # a band from 0 on a system with free rigid-body motion: the lower edge is the limit Ω → 0
-    lo_eval, at_zero = _zero_limit(system, names, cols, hi, roots) if lo == 0.0 else (lo, None)
+    # free rigid-body roots (s = 0) make Z(Ω) singular to rounding near 0: below the zone's step the response is
+    # the limit model (its value at 0, or an error naming the band where an output grows without bound there)
+    zone = zero_zone(system, hi, roots)
+    if zone is not None and lo >= zone.step:
+        zone = None
+    near_zero = None
+    if zone is not None:
+        near_zero = _near_zero(system, zone, cols, lo)
+        if lo == 0.0 and near_zero.growing.any():
+            bad = [nm for nm, g in zip(names, near_zero.growing, strict=True) if g]
+            raise ValueError(f"band: starts at 0 Hz, where the output(s) {bad} are unbounded (free rigid-body "
+                             "motion: Z(0) is singular and the response grows as Ω → 0); start the band above 0")
+    lo_eval = zone.step if zone is not None else lo
     edges_eval = np.array([lo_eval, hi])
     clipped_eval = np.clip(wd, lo_eval, hi)
-    # an undamped mode inside the band has an unbounded peak, whatever rounding makes of Z(ω_d)
-    undamped = (np.abs(modes.real) <= UNDAMPED_ROOT * np.abs(modes)) & (modes.imag != 0)  # system.undamped_modes()
+    # an undamped mode inside the band has an unbounded peak, whatever rounding makes of Z(ω_d); the neutral roots
+    # of free rigid-body motion (s ≈ 0, perhaps ±iδ by rounding) are not modes with a peak
+    scale = float(np.max(np.abs(roots), initial=0.0))
+    neutral_modes = np.abs(modes) <= NEUTRAL_ROOT * scale
+    undamped = (np.abs(modes.real) <= UNDAMPED_ROOT * np.abs(modes)) & (modes.imag != 0) & ~neutral_modes
     resonant = undamped & (wd >= lo) & (wd <= hi)
     if not exact:
         freqs = np.concatenate([clipped, edges])
         H = _finite_or_inf(np.abs(_direct(system, np.concatenate([clipped_eval, edges_eval]), cols)))
-        if lo_eval > lo:  # the limit Ω → 0 at the lower edge (and at modes clipped to it)
-            H[np.concatenate([clipped_eval, edges_eval]) == lo_eval] = at_zero
+        if near_zero is not None:  # the limit model at the lower edge (and at modes clipped to it)
+            H[np.concatenate([clipped_eval, edges_eval]) == lo_eval] = near_zero.values
         out = {}
         for i, nm in enumerate(names):
             vals = H[:, i].copy()
@@ -206,11 +221,14 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
             out[nm] = ResponseMaxima(vals, freqs, wd, (lo, hi), exact=False, output=nm)
         return out
 
-    poles = system.modal().s
+    modal = system.modal()
+    poles = modal.s
     poles = poles[np.abs(poles.real) > UNDAMPED_ROOT * np.abs(poles)]  # their cells are inf anyway
-    if lo_eval > lo:  # the outputs have a finite limit at 0: the neutral poles are cancelled there
-        poles = poles[np.abs(poles) > NEUTRAL_ROOT * np.max(np.abs(system.modal().s))]
-    bounds = np.concatenate([[lo_eval], 0.5 * (clipped_eval[1:] + clipped_eval[:-1]), [hi]])
+    if zone is not None:  # the outputs have a finite limit at 0: the neutral poles are cancelled there
+        poles = poles[np.abs(poles) > NEUTRAL_ROOT * scale]
+    # cell boundaries from the band's clipping (not the zone's step, which moves with the design): the same cells
+    # whatever the limit model, so a maximum on a boundary moves with the damped frequencies only
+    bounds = np.concatenate([[lo_eval], np.maximum(0.5 * (clipped[1:] + clipped[:-1]), lo_eval), [hi]])
     max_delay = system.max_delay
     grid, ratio = band_grid(poles, (lo_eval, hi), max_delay=max_delay or 0.0,
                             extra=np.concatenate([clipped_eval, bounds]))
@@ -220,58 +238,155 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
         pr = None
         result = _exact_cells(system, None, grid, bounds, cols, edges_eval)
     cell_f, cell_x, all_finite, edge_vals = result
-    if lo_eval > lo:  # the limit Ω → 0: the lower edge's value, and the first cell's if it is larger
-        edge_vals[0] = at_zero
-        first = at_zero
+    if near_zero is not None:  # the limit model: the lower edge's value, and the first cell's if it is larger
+        edge_vals[0] = near_zero.values
+        first = near_zero.values
         larger = first > cell_f[:, 0]
         cell_f[larger, 0], cell_x[larger, 0] = first[larger], lo_eval
-    spacing = ratio <= CERTIFIED_RATIO * (1 + 1e-9)
-    certified = bool(all_finite and max_delay is not None and spacing)
-    reason = "" if certified else "; ".join(text for ok, text in (
-        (max_delay is not None, "the forcing does not declare its delays"),
-        (spacing, f"the grid broke the spacing rule (ratio {ratio:.3g})"),
-        (all_finite, "a sample was singular (an undamped or rigid-body pole on the band)")) if not ok)
+    reasons = _uncertified(system, modal, roots, resonant, wd, (lo, hi), max_delay, ratio, all_finite)
     out = {}
     for i, nm in enumerate(names):
         f, x = cell_f[i].copy(), cell_x[i].copy()
         f[resonant] = np.inf
         x[resonant] = clipped[resonant]
-        x[x == lo_eval] = lo  # the limit Ω → 0 is reported at 0
+        x[x == lo_eval] = lo  # the limit model is reported at the lower edge
+        why = list(reasons)
+        if near_zero is not None and near_zero.growing[i]:
+            why.append(f"the output grows without bound as Ω → 0 (free rigid-body motion) and the lower edge "
+                       f"{lo:.6g} rad/s lies where Z(Ω) is singular to rounding (below {zone.step:.3g} rad/s)")
+        elif near_zero is not None:
+            top, edge, err = float(np.max(f)), near_zero.values[i], near_zero.error[i]
+            if edge + err >= top * (1 - CERTIFIED_RTOL) and err > CERTIFIED_RTOL * top:
+                why.append(f"the maximum may be the limit Ω → {lo:.6g} rad/s, known only to {err / top:.2g} "
+                           "relative (free rigid-body roots make Z(Ω) singular there)")
         out[nm] = ResponseMaxima(
             np.concatenate([f, edge_vals[:, i]]), np.concatenate([x, edges]), wd, (lo, hi), exact=True,
-            certified=certified, grid_ratio=ratio, output=nm,
-            evaluation="direct" if pr is None else "pole-residue", grid_points=len(grid), reason=reason,
+            certified=not why, grid_ratio=ratio, output=nm,
+            evaluation="direct" if pr is None else "pole-residue", grid_points=len(grid), reason="; ".join(why),
         )
     return out
 
 
-ZERO_STEP = 1.2e-4  # Ω = ZERO_STEP · (least non-neutral |s|) and 2Ω extrapolate H to Ω → 0 when Z(0) is singular
+ZERO_STEP = 1e-3  # ε = ZERO_STEP · (least non-neutral |s|): the nodes ε, 2ε, 4ε of the limit model near Ω = 0
+RESOLVED_DAMPING = 100.0  # a pole's |Re s| must exceed this × its rounding ε·κ_k·max|s| to be certified
+CERTIFIED_RTOL = 1e-8  # what ``certified`` promises: U is the band maximum to this relative accuracy
 
 
-def _zero_limit(system: LinearSystem, names: list[str], cols: list[int], hi: float,
-                roots: np.ndarray | None = None) -> tuple[float, np.ndarray]:
-    """For a band from 0 Hz: ``(lower edge to sample, |H(0)| per output column)``.
+@dataclass(frozen=True)
+class ZeroZone:
+    """Where free rigid-body roots (s ≈ 0) make Z(Ω) singular to rounding: Ω below ``step`` = ε (rad/s).
 
-    Without free rigid-body roots the edge is 0 itself.  With them (s = 0, Z(0) singular) every output must
-    have a finite limit at 0 (the poles at the origin cancel, e.g. the acceleration of a free body): H is
-    sampled at ε = 1.2e-4·|s_min| (rounding of the nearly singular solve ~ε_mach/1.2e-4² ≈ 1e-8 relative) and
-    2ε, and the limit is the linear extrapolation 2H(ε) − H(2ε) (error O(ε²)).  An output that grows as Ω → 0
-    (the displacement of a free body under a force) is truly unbounded: its band is refused naming ``band``.
+    There ``H`` is the limit model: the quadratic through the direct solves at ε, 2ε and 4ε (Lagrange
+    weights :meth:`weights`), exact to O(ε³) and, at Ω = 0, the limit of outputs whose poles at the origin cancel
+    (H(0) ≈ (8H(ε) − 6H(2ε) + H(4ε))/3).
+    """
+
+    step: float
+
+    @property
+    def nodes(self) -> np.ndarray:
+        """The frequencies ε, 2ε, 4ε (rad/s) the model interpolates."""
+        return self.step * np.array([1.0, 2.0, 4.0])
+
+    def weights(self, omega: float) -> np.ndarray:
+        """Lagrange weights (3,) of H at :attr:`nodes` giving the model at ``omega`` (rad/s, 0 ≤ omega ≤ ε)."""
+        a = float(omega) / self.step
+        return np.array([(a - 2) * (a - 4) / 3.0, -(a - 1) * (a - 4) / 2.0, (a - 1) * (a - 2) / 6.0])
+
+
+@dataclass(frozen=True)
+class _NearZero:
+    values: np.ndarray  # |H| of the limit model at the lower edge, per output
+    error: np.ndarray  # its estimated error: the magnitude of the same model through 2ε, 4ε, 8ε differs by this much
+    growing: np.ndarray  # outputs that grow without bound as Ω → 0 (no limit)
+
+
+def zero_zone(system: LinearSystem, hi: float, roots: np.ndarray | None = None) -> ZeroZone | None:
+    """The zone near Ω = 0 where free rigid-body roots make ``Z(Ω)`` singular to rounding, or None without them.
+
+    Roots with |s| ≤ NEUTRAL_ROOT·max|s| are free rigid-body motion (s = 0 perturbed by rounding, perhaps to ±iδ).
+    The zone's step is ε = 1.2e-4·(least non-neutral |s|), at most 1e-3·``hi`` (rad/s); below ε the rounding of a
+    direct solve grows as 1/Ω² (the response there is :class:`ZeroZone`'s limit model).
     """
     s = system.eigenvalues() if roots is None else roots
     scale = float(np.max(np.abs(s))) if s.size else 0.0
     neutral = np.abs(s) <= NEUTRAL_ROOT * scale
-    if scale == 0.0 or not np.any(neutral):
-        return 0.0, None
-    eps = min(ZERO_STEP * float(np.min(np.abs(s[~neutral]))), 1e-3 * hi)
-    H = _direct(system, np.array([eps, 2 * eps, 0.1 * eps]), cols)
+    if scale == 0.0 or not np.any(neutral) or np.all(neutral):
+        return None
+    return ZeroZone(min(ZERO_STEP * float(np.min(np.abs(s[~neutral]))), 1e-3 * hi))
+
+
+def _near_zero(system: LinearSystem, zone: ZeroZone, cols: list[int], lo: float) -> _NearZero:
+    """|H| at ``lo`` (< zone.step) by the limit model with its error estimate, and which outputs grow as Ω → 0
+    (|H(ε/10)| > 1.5|H(ε)|: the displacement of a free body under a force); for those the value is the direct
+    solve at ``lo`` (its rounding then unbounded)."""
+    eps = zone.step
+    H = _direct(system, np.array([eps, 2 * eps, 4 * eps, 8 * eps, 0.1 * eps]), cols)
     mags = np.abs(H)
-    growing = ~np.isfinite(mags[2]) | (mags[2] > 1.5 * mags[0] + 1e-300)
-    if np.any(growing):
-        bad = [nm for nm, g in zip(names, growing, strict=True) if g]
-        raise ValueError(f"band: starts at 0 Hz, where the output(s) {bad} are unbounded (free rigid-body motion: "
-                         "Z(0) is singular and the response grows as Ω → 0); start the band above 0")
-    return eps, np.abs(2 * H[0] - H[1])
+    growing = ~np.isfinite(mags[4]) | (mags[4] > 1.5 * mags[0] + 1e-300)
+    model = zone.weights(lo) @ H[:3]
+    coarse = ZeroZone(2 * eps).weights(lo) @ H[1:4]
+    values = np.abs(model)
+    error = np.abs(np.abs(model) - np.abs(coarse))  # of the magnitude reported (a change in phase does not count)
+    if np.any(growing) and lo > 0.0:
+        values = np.where(growing, _finite_or_inf(np.abs(_direct(system, np.array([lo]), cols)[0])), values)
+    return _NearZero(values, error, growing)
+
+
+def _uncertified(system: LinearSystem, modal, roots: np.ndarray, resonant: np.ndarray, wd: np.ndarray,
+                 band: tuple[float, float], max_delay: float | None, ratio: float, all_finite: bool) -> list[str]:
+    """Why the cell maxima are not certified (empty when they are), common to every output."""
+    lo, hi = band
+    why = []
+    if max_delay is None:
+        why.append("the forcing does not declare its delays")
+    if not ratio <= CERTIFIED_RATIO * (1 + 1e-9):
+        needed = _delay_points(band, max_delay or 0.0)
+        why.append(f"the grid broke the spacing rule (ratio {ratio:.3g})" + (
+            f": the delay {max_delay:.6g} s alone needs {needed} points, more than {MAX_GRID_POINTS}"
+            if needed > MAX_GRID_POINTS else ""))
+    if not all_finite:
+        why.append("a sample was singular (an undamped or rigid-body pole on the band)")
+    if resonant.any():
+        j = int(np.flatnonzero(resonant)[0])
+        mode = roots[1::2][j]
+        why.append(f"mode {j + 1} at {wd[j] / (2 * np.pi):.6g} Hz has damping ratio {abs(mode.real) / abs(mode):.3g} "
+                   f"≤ {UNDAMPED_ROOT:g} (undamped to rounding): its peak is taken as unbounded, a finite one is "
+                   "not resolved in double precision")
+    # neutral roots are taken as free rigid-body motion (s = 0 up to rounding: real pairs ±δ, or ±iδ on the axis); a
+    # complex pair among them damped beyond rounding is a genuine mode too soft for the search, whose peak is missed
+    s = modal.s
+    scale = float(np.max(np.abs(s), initial=0.0))
+    rounding = np.finfo(float).eps * scale
+    soft = (np.abs(s) <= NEUTRAL_ROOT * scale) & (s.imag != 0) & (-s.real > RESOLVED_DAMPING * rounding)
+    if soft.any():
+        root = s[soft][0]
+        why.append(f"the root s = {root.real:.3g}{root.imag:+.3g}i 1/s is below {NEUTRAL_ROOT:g}·max|s| (taken as "
+                   "free rigid-body motion) yet damped beyond rounding: a mode too soft for the band search")
+    # a pole whose damping is within rounding of the eigenvalue: the grid, built around the computed pole, cannot
+    # be trusted to resolve the true peak (near-defective pairs, tiny damping)
+    inside = ((np.abs(s.imag) >= lo) & (np.abs(s.imag) <= hi) & (np.abs(s) > NEUTRAL_ROOT * scale)
+              & (np.abs(s.real) > UNDAMPED_ROOT * np.abs(s)))
+    if inside.any():
+        with np.errstate(invalid="ignore", over="ignore"):
+            kappa = np.linalg.norm(modal.V[:, inside], axis=0) * np.linalg.norm(modal.W[inside], axis=1)
+            rounding = np.finfo(float).eps * kappa * scale
+            unresolved = ~(np.abs(s.real[inside]) > RESOLVED_DAMPING * rounding)
+        if unresolved.any():
+            k = int(np.flatnonzero(unresolved)[0])
+            pole = s[inside][k]
+            why.append(f"the pole s = {pole.real:.6g}{pole.imag:+.6g}i 1/s has its damping within rounding of the "
+                       f"eigen-decomposition (eigenvalue condition {kappa[k]:.3g}; a defective or nearly repeated "
+                       "pair): the grid around it may not resolve the peak")
+    return why
+
+
+def _delay_points(band: tuple[float, float], max_delay: float) -> int:
+    """Points the uniform grid of the delay rule needs over ``band``: step 0.9·GRID_FACTOR·2π/(4τ_max)."""
+    if max_delay <= 0:
+        return 0
+    step = 0.9 * GRID_FACTOR * 2 * np.pi / (4 * max_delay)
+    return int(np.ceil((band[1] - band[0]) / step)) + 1
 
 
 def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray, cols: list[int],
@@ -371,10 +486,8 @@ def band_grid(poles: np.ndarray, band: tuple[float, float], max_delay: float = 0
     its worst step ratio (see :func:`_step_ratios`; certified when ≤ CERTIFIED_RATIO).
     """
     lo, hi = band
-    uniform = (hi - lo) / (4 * MIN_CELL_SAMPLES)
-    if max_delay > 0:
-        uniform = min(uniform, 0.9 * GRID_FACTOR * 2 * np.pi / (4 * max_delay))
-    parts = [np.linspace(lo, hi, int(np.ceil((hi - lo) / uniform)) + 1)]
+    count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points(band, max_delay), MAX_GRID_POINTS))
+    parts = [np.linspace(lo, hi, count)]  # a delay that needs more breaks the rule (the ratio says so)
     upper = poles[(poles.imag >= 0) & (poles.real != 0)]
     if upper.size:  # every pole's points at once: u0 + i·δ exactly as np.arange(u0, u1 + POLE_STEP, POLE_STEP)
         sigma, omega = np.abs(upper.real), upper.imag

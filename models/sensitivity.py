@@ -12,7 +12,9 @@ the system alone and shares its one eigen-decomposition:
   maximiser (plus the motion of a cell boundary when the maximum sits on one).
 
 ``∂H/∂p_i = (iΩ)^q wᵀ(F_i − Z_i X)`` with the adjoint ``Zᵀw = c`` (one extra solve per frequency,
-all outputs at once).
+all outputs at once).  Where free rigid-body roots make Z(Ω) singular to rounding (a band from 0 Hz: below
+:class:`~railopt.models.response_maxima.ZeroZone`'s step), H and ∂H/∂p are the same limit model the values use:
+the quadratic through the partials at ε, 2ε and 4ε, so the derivative is that of the value reported at Ω → 0.
 """
 
 from __future__ import annotations
@@ -21,8 +23,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from railopt.models.modal import mode_order
-from railopt.models.response_maxima import ResponseMaxima, all_response_maxima
+from railopt.models.modal import NEUTRAL_ROOT, mode_order
+from railopt.models.response_maxima import ResponseMaxima, ZeroZone, all_response_maxima, zero_zone
 from railopt.models.system import LinearSystem, Tangent
 from railopt.models.validation import band_arg
 
@@ -43,11 +45,51 @@ def eigenvalue_derivatives(system: LinearSystem, dM: np.ndarray, dC: np.ndarray,
     m = system.modal()
     n = system.n
     AB = np.linalg.solve(system.M, np.hstack([system.K, system.C]))  # [M⁻¹K, M⁻¹C]
+    W = left_eigenvectors(system)
     out = np.zeros((2 * n, len(dK)), dtype=complex)
     for i in range(len(dK)):
         dAB = -np.linalg.solve(system.M, np.hstack([dK[i], dC[i]]) - dM[i] @ AB)
-        out[:, i] = np.einsum("kj,jk->k", m.W[:, n:], dAB @ m.V)
+        out[:, i] = np.einsum("kj,jk->k", W[:, n:], dAB @ m.V)
     return out
+
+
+LEFT_CONDITION = 1e6  # cond₁(V) above which the left eigenvectors come from eig(Gᵀ), not from W = V⁻¹
+
+
+def left_eigenvectors(system: LinearSystem) -> np.ndarray:
+    """Left eigenvectors (rows, (2n, 2n)) of the state matrix G, biorthogonal to the right ones (``W V = I`` within
+    each cluster of equal roots), roots in the order of ``system.modal().s``.
+
+    ``W = V⁻¹`` when V is well conditioned (cond₁(V) ≤ :data:`LEFT_CONDITION`).  A defective root — the double
+    root s = 0 of free rigid-body motion, a flutter coalescence — makes V nearly singular, and the rounding of V⁻¹
+    then spoils the rows of every root, the simple ones too.  There the left vectors are the eigenvectors of Gᵀ (a
+    second eigen-decomposition), each root matched to its nearest unused root of Gᵀ, and normalised cluster by
+    cluster (roots within 1e-8·max|s| of each other): accurate for every simple root; a
+    defective cluster's rows are as ill-determined as its derivatives (inf or NaN where exactly singular).
+    """
+    m = system.modal()
+    if m.condition <= LEFT_CONDITION:
+        return m.W
+    s_left, U = np.linalg.eig(system.state_matrix().T)
+    distance = np.abs(m.s[:, None] - s_left[None, :])
+    match = np.empty(len(m.s), dtype=np.intp)
+    free = np.ones(len(s_left), dtype=bool)
+    for k in np.argsort(np.min(distance, axis=1)):  # each root its nearest unused root of Gᵀ, closest pairs first
+        j = int(np.argmin(np.where(free, distance[k], np.inf)))
+        match[k], free[j] = j, False
+    W = U[:, match].T
+    right = mode_order(m.s)
+    sorted_s = m.s[right]
+    tol = 1e-8 * float(np.max(np.abs(m.s), initial=0.0))
+    cuts = np.flatnonzero(np.abs(np.diff(sorted_s)) > tol) + 1
+    for cluster in np.split(right, cuts):
+        Y, X = W[cluster], m.V[:, cluster]
+        try:
+            with np.errstate(all="ignore"):
+                W[cluster] = np.linalg.solve(Y @ X, Y)
+        except np.linalg.LinAlgError:  # an exactly defective cluster: no derivative exists
+            W[cluster] = np.nan
+    return W
 
 
 def damped_frequency_jacobian(system: LinearSystem) -> np.ndarray:
@@ -86,6 +128,23 @@ def _partials(system: LinearSystem, omega: float, cols: list[int]) -> tuple[np.n
     return H, dH, dHw
 
 
+def _partials_at(system: LinearSystem, omega: float, cols: list[int], zone: ZeroZone | None,
+                 hi: float) -> tuple[np.ndarray, ...]:
+    """:func:`_partials`, or where Z(Ω) is singular to rounding (free rigid-body roots near 0, inside ``zone``) or
+    exactly singular, the limit model: the quadratic through the partials at three frequencies above Ω (the
+    zone's ε, 2ε, 4ε; or Ω + (1, 2, 4)·1e-7·hi), evaluated at Ω."""
+    if zone is not None and omega < zone.step:
+        nodes, weights = zone.nodes, zone.weights(omega)
+    else:
+        try:
+            return _partials(system, omega, cols)
+        except np.linalg.LinAlgError:  # a finite value at a singular Z: its limit from above
+            nodes = omega + 1e-7 * hi * np.array([1.0, 2.0, 4.0])
+            weights = ZeroZone(1e-7 * hi).weights(0.0)
+    parts = [_partials(system, float(w), cols) for w in nodes]
+    return tuple(sum(c * part[k] for c, part in zip(weights, parts, strict=True)) for k in range(3))
+
+
 def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
                      band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                      outputs: Sequence[str] | None = None, maxima: Mapping[str, ResponseMaxima] | None = None,
@@ -109,7 +168,10 @@ def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tupl
     n, P = system.n, len(t.parameters)
     dwd = damped_frequency_jacobian(system)
     wd = system.damped_frequencies()
-    inside = (wd > lo) & (wd < hi)
+    modes = system.mode_roots()
+    neutral = np.abs(modes) <= NEUTRAL_ROOT * float(np.max(np.abs(system.eigenvalues()), initial=0.0))
+    inside = (wd > lo) & (wd < hi) & ~neutral  # rigid-body roots (s ≈ 0) do not move a frequency of the maxima
+    zone = zero_zone(system, hi)
     dclip = np.where(inside[:, None], dwd, 0.0)
     result = {}
     for name in names:
@@ -131,7 +193,7 @@ def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tupl
         for k, omega in enumerate(rm.frequencies):
             if not np.isfinite(rm.values[k]) or rm.values[k] == 0.0:
                 continue
-            H, dH, dHw = _partials(system, float(omega), [col])
+            H, dH, dHw = _partials_at(system, float(omega), [col], zone, hi)
             J[k] = (np.real(np.conj(H[0]) * dH[0]) + np.real(np.conj(H[0]) * dHw[0]) * dOmega[k]) / abs(H[0])
         result[name] = (rm, J)
     return result
@@ -175,6 +237,6 @@ def damping_ratio_jacobian(s: np.ndarray, ds: np.ndarray) -> np.ndarray:
 
 
 __all__ = [
-    "damped_frequency_jacobian", "damping_ratio_jacobian", "eigenvalue_derivatives", "maxima_jacobians",
-    "response_maxima_jacobian", "root_jacobian", "root_speed_derivative",
+    "LEFT_CONDITION", "damped_frequency_jacobian", "damping_ratio_jacobian", "eigenvalue_derivatives",
+    "left_eigenvectors", "maxima_jacobians", "response_maxima_jacobian", "root_jacobian", "root_speed_derivative",
 ]
