@@ -39,6 +39,7 @@ from railopt.models.vehicle.vehicle import Vehicle
 
 MAX_LENGTH_M = 30.0  # a [lengths] value: the longest rail vehicle bodies are ~27.5 m (UIC-Z coaches 26.4 m)
 OVERHANG_M = 6.0  # beyond the outermost wheelset (coaches ~2.4 m, locomotives 3-4 m)
+POSITION_USUAL_M = 0.3  # a body or mount off the vehicle centre in x lies at least this far from it (or at 0)
 LATERAL_USUAL_M = 0.15  # off-centre attachments (springs, dampers, axleboxes) lie 0.15-2 m from the centre line
 CG_LATERAL_M = 0.3  # |y| of a body's CG: bodies are laterally near-symmetric (load offsets are limited to ~0.1 m)
 AXLE_SPACING_BOGIE_M = (1.4, 3.2)  # adjacent axles of a bogie: 1.8 m (Y25 freight), 2.5-2.8 m (passenger),
@@ -125,7 +126,7 @@ def _coordinate(v: Vehicle, path: str, what: str, p: np.ndarray, extent, rel: np
     x, y, z = (float(c) for c in p)
     band = extent or (-MAX_HALF_LENGTH_M, MAX_HALF_LENGTH_M)
     if _off(x, band):
-        slip = likely_slip(rel[0], (0.01, max(abs(band[0]), abs(band[1]))), LENGTH_UNITS, "m")
+        slip = likely_slip(rel[0], (POSITION_USUAL_M, max(abs(band[0]), abs(band[1]))), LENGTH_UNITS, "m")
         where = "the vehicle's extent (its outermost wheelsets ± 6 m)" if extent else "any rail vehicle"
         yield PlausibilityWarning(f"{path}[0]", f"{what} at x = {x:g} m lies outside {where}, "
                                   f"{band[0]:.4g} to {band[1]:.4g} m{suffix(slip)}{named_lengths(v, rel[0])}",
@@ -135,7 +136,7 @@ def _coordinate(v: Vehicle, path: str, what: str, p: np.ndarray, extent, rel: np
         yield PlausibilityWarning(f"{path}[1]", f"{what} at y = {y:g} m is wider than {lateral:g} m off the centre "
                                   f"line{suffix(slip)}{named_lengths(v, rel[1])}", y, "lateral_offset")
     if _off(z, POINT_HEIGHT_M):
-        slip = likely_slip(rel[2], (0.01, POINT_HEIGHT_M[1]), LENGTH_UNITS, "m")
+        slip = likely_slip(rel[2], (0.1, POINT_HEIGHT_M[1]), LENGTH_UNITS, "m")
         yield PlausibilityWarning(f"{path}[2]", f"{what} at z = {z:g} m above rail is outside "
                                   f"{POINT_HEIGHT_M[0]:g} to {POINT_HEIGHT_M[1]:g} m{suffix(slip)}"
                                   f"{named_lengths(v, rel[2])}", z, "height")
@@ -386,7 +387,7 @@ def _symmetry(v: Vehicle) -> list[PlausibilityWarning]:
 
 __all__ = [
     "AXES", "AXLEBOX_Y_M", "AXLE_SPACING_BOGIE_M", "AXLE_SPACING_BOGIE_USUAL_M", "AXLE_SPACING_CARRIED_M",
-    "BOGIE_CG_TOL_M", "CG_LATERAL_M", "LATERAL_USUAL_M", "MAX_LENGTH_M", "OVERHANG_M",
+    "BOGIE_CG_TOL_M", "CG_LATERAL_M", "LATERAL_USUAL_M", "POSITION_USUAL_M", "MAX_LENGTH_M", "OVERHANG_M",
     "PAIR_GAP_M", "PAIR_OFF_LINE_M", "SAME_POINT_M", "VEHICLE_CG_FRACTION", "WHEEL_GAP_M",
     "layout_checks", "named_lengths",
 ]

@@ -5,14 +5,16 @@ against the element's name, and the running gear of one vehicle against itself.
 Checks (bands are module constants, sources in the comments):
 
 * **gyration against size**: a radius of gyration √(I/m) far below the spread of the body's attachment points
-  (Iyy of a 20 m car body in t·m²), a roll gyration larger than any cross-section allows (Ixx ↔ Izz swapped: 7.4 m
-  on a car body), a pitch or yaw gyration longer than the vehicle;
+  (Iyy of a 20 m car body in t·m²) or beyond it (a bogie frame's mass ÷10), a roll gyration larger than any
+  cross-section allows (Ixx ↔ Izz swapped: 7.85 m on the coach's body), a pitch or yaw gyration longer than the
+  vehicle;
 * **gyration against each other**: any rigid body has I₁ ≤ I₂ + I₃; a body flat in z (attachment points spread in
   x and y, not in z: car bodies, bogie frames) has its largest moment about z; a body long in x its smallest about
   x; a wheelset its smallest about its axle (Iyy);
 * **masses against each other**: a bogie frame heavier than half the car body it carries;
 * **role**: the primary suspension's stiffness per wheelset and direction (wheelset to frame) and the
-  secondary's per bogie, below what any running gear has (a stiffness in kN/m);
+  secondary's per bogie, below what any running gear has (a stiffness in kN/m); the primary damping above what
+  any axlebox damper set has (×1000);
 * **restraint**: a wheelset that no spring or constraint holds laterally or in yaw to its frame;
 * **consistency**: one wheelset's primary (or one bogie's secondary) unlike the others' (an element deleted, a
   value slipped on one copy);
@@ -39,6 +41,9 @@ from railopt.models.vehicle.slips import INERTIA_UNITS, MASS_UNITS, STIFFNESS_UN
 from railopt.models.vehicle.vehicle import Vehicle
 
 GYRATION_SPAN_MIN = 0.1  # √(I/m) at least this fraction of the attachment points' spread (uniform bar: 0.29)
+GYRATION_SPAN_MAX = 1.0  # √(I/m) at most the spread plus GYRATION_SLACK_M (bodies reach ~20 % past their mounts)
+GYRATION_SLACK_M = 0.5
+ROLL_SLACK_M = 1.5  # roll: a body's cross-section (~3 x 3.5 m) reaches well past mounts near its centre line
 SPAN_MIN_M = 0.5  # spreads below this say nothing about a body's size
 ROLL_GYRATION_MAX_M = 3.0  # √(Ixx/m) of a body inside a loading gauge (≤ 3.75 m wide, ≤ ~5.5 m above rail)
 OVERHANG_M = 6.0  # a vehicle's half-length: its outermost wheelset plus this
@@ -56,8 +61,11 @@ PRIMARY_USUAL_N_PER_M = ((2.0e6, 2.0e8), (1.0e6, 5.0e7), (5.0e5, 2.0e7))
 # 0.3-1 MN/m vertically; coil secondaries stiffer.  Manchester coach 0.32 / 0.32 / 0.86 MN/m.
 SECONDARY_MIN_N_PER_M = (3.0e4, 5.0e4, 1.0e5)
 SECONDARY_USUAL_N_PER_M = ((1.0e5, 5.0e7), (1.0e5, 1.0e7), (3.0e5, 2.0e7))
+# Primary damping per wheelset and direction, N s/m: axlebox dampers are 2-30 kN s/m each (Manchester coach 8 kN s/m
+# vertically per wheelset, sd40-2 30 kN s/m); above 0.5 MN s/m the wheelset is locked to its frame.
+PRIMARY_DAMPING_MAX_N_S_PER_M = 5.0e5
 MISMATCH_RATIO = 1.5  # one wheelset's (bogie's) total against the median of the others
-DIRECTION_MIN = 0.5  # |component| along the named axis (cos 60°)
+DIRECTION_MIN = 0.8  # |component| along the named axis (cos 37°: an inclined damper keeps its name's axis)
 
 
 def suspension_checks(v: Vehicle, gear: RunningGear) -> list[PlausibilityWarning]:
@@ -110,6 +118,15 @@ def _inertias(v: Vehicle) -> list[PlausibilityWarning]:
                     f"{label}.inertia_kg_m2[{k}]", f"radius of gyration about {AXES[k]} √(I/m) = {r[k]:.3g} m on a "
                     f"body whose attachment points spread {spread:.3g} m: below {GYRATION_SPAN_MIN:g} of its size"
                     f"{suffix(slip)}", float(r[k]), "gyration_size"))
+        for k in range(3):
+            spread = float(max(s[[i for i in range(3) if i != k]]))
+            slack = ROLL_SLACK_M if k == 0 else GYRATION_SLACK_M
+            beyond = r[k] > GYRATION_SPAN_MAX * spread + slack and not (k == 0 and r[0] > ROLL_GYRATION_MAX_M)
+            if spread >= SPAN_MIN_M and beyond:  # (a roll beyond any cross-section is said below)
+                out.append(PlausibilityWarning(
+                    f"{label}.inertia_kg_m2[{k}]", f"radius of gyration about {AXES[k]} √(I/m) = {r[k]:.3g} m on a "
+                    f"body whose attachment points spread {spread:.3g} m: its mass would lie beyond them; the mass "
+                    f"({b.mass:g} kg) too small or the inertia too large?", float(r[k]), "gyration_size"))
         if r[0] > ROLL_GYRATION_MAX_M:
             out.append(PlausibilityWarning(
                 f"{label}.inertia_kg_m2[0]", f"roll radius of gyration √(Ixx/m) = {r[0]:.3g} m: no body inside a "
@@ -214,6 +231,8 @@ def _roles(v: Vehicle, gear: RunningGear) -> list[PlausibilityWarning]:
                 for owner, total in group.items():
                     if 0.0 < total < low[k]:
                         out.append(_low(v, gear, role, owner, k, total, low[k], usual[k]))
+            if matrix == "C" and not rotational and role == "primary":
+                out += _damping_high(v, gear, k, group)
             out += _mismatch(v, role, matrix, rotational, k, group, per)
     return out
 
@@ -276,6 +295,22 @@ def _low(v: Vehicle, gear: RunningGear, role: str, owner: str, k: int, total: fl
         f"running gear (the unit is N/m){suffix(slip)}", total, f"{role}_stiffness")
 
 
+def _damping_high(v: Vehicle, gear: RunningGear, k: int, group: dict[str, float]) -> list[PlausibilityWarning]:
+    """Primary damping per wheelset and direction above :data:`PRIMARY_DAMPING_MAX_N_S_PER_M`."""
+    wheelsets = {b.name for b in v.wheelsets}
+    out = []
+    for owner, total in group.items():
+        if total > PRIMARY_DAMPING_MAX_N_S_PER_M:
+            ids = sorted({e.id for e in v.elements if gear.role(e, wheelsets) == "primary" and e.matrix == "C"
+                          and not e.rotational and owner in (e.body_a, e.body_b) and abs(e.direction[k]) > 1e-6})
+            slip = likely_slip(total, (1.0e3, PRIMARY_DAMPING_MAX_N_S_PER_M), (), "N·s/m")
+            out.append(PlausibilityWarning(
+                f"elements ({', '.join(ids)}).damping_N_s_per_m", f"primary {AXES[k]} damping of {owner} totals "
+                f"{total:.4g} N·s/m, above the {PRIMARY_DAMPING_MAX_N_S_PER_M:.3g} N·s/m of any axlebox damper set "
+                f"(primary dampers: 2-30 kN·s/m each){suffix(slip)}", total, "primary_damping"))
+    return out
+
+
 def _mismatch(v: Vehicle, role: str, matrix: str, rotational: bool, k: int, group: dict[str, float],
               per: str) -> list[PlausibilityWarning]:
     if len(group) < 2:
@@ -316,8 +351,8 @@ def _directions(v: Vehicle) -> list[PlausibilityWarning]:
 
 
 __all__ = [
-    "DIRECTION_MIN", "FLAT_RATIO", "FRAME_MASS_FRACTION", "GYRATION_SPAN_MIN", "LONG_RATIO", "MISMATCH_RATIO",
-    "ORDER_TOL", "OVERHANG_M", "PRIMARY_MIN_N_PER_M", "PRIMARY_USUAL_N_PER_M", "ROLL_GYRATION_MAX_M",
-    "SECONDARY_MIN_N_PER_M", "SECONDARY_USUAL_N_PER_M", "SPAN_MIN_M", "WHEELSET_INERTIA_RATIO", "spans",
-    "suspension_checks",
+    "DIRECTION_MIN", "FLAT_RATIO", "FRAME_MASS_FRACTION", "GYRATION_SLACK_M", "GYRATION_SPAN_MAX",
+    "GYRATION_SPAN_MIN", "LONG_RATIO", "MISMATCH_RATIO", "ORDER_TOL", "OVERHANG_M", "PRIMARY_DAMPING_MAX_N_S_PER_M",
+    "PRIMARY_MIN_N_PER_M", "PRIMARY_USUAL_N_PER_M", "ROLL_GYRATION_MAX_M", "ROLL_SLACK_M", "SECONDARY_MIN_N_PER_M",
+    "SECONDARY_USUAL_N_PER_M", "SPAN_MIN_M", "WHEELSET_INERTIA_RATIO", "spans", "suspension_checks",
 ]
