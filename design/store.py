@@ -48,7 +48,7 @@ import os
 import sqlite3
 import uuid
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -166,7 +166,9 @@ def _configure(path: Path, db: sqlite3.Connection, read_only: bool) -> None:
     Switching a closed store (rollback journal) to WAL needs every reader gone: a reader holding a read
     transaction is waited for up to :data:`BUSY_TIMEOUT` s, then the open fails with a :class:`StoreError` naming
     the processes that have the file open — not a failure at the first write of a resumed campaign."""
-    db.execute(f"PRAGMA busy_timeout = {int(BUSY_TIMEOUT * 1000)}")
+    # every statement is read to its end (a pragma returns a row): one left pending holds the connection's read
+    # lock, and close() could not fold the log back (the store stayed in WAL mode with -wal/-shm files beside it)
+    db.execute(f"PRAGMA busy_timeout = {int(BUSY_TIMEOUT * 1000)}").fetchall()
     if read_only:
         return
     try:
@@ -344,17 +346,20 @@ class CampaignStore:
             raise
 
     def close(self) -> None:
-        """Checkpoint the write-ahead log into the store file (without waiting for readers), then close."""
-        if str(self.path) != ":memory:" and not self.read_only:
-            try:
-                self._db.execute("PRAGMA busy_timeout = 0")  # a reader still attached: leave the log for later
-                self._db.execute("PRAGMA wal_checkpoint(TRUNCATE)").fetchall()
-                # back to a single self-contained file (no -wal/-shm left by later readers); a reader still
-                # attached keeps it in WAL mode, which is as safe
-                self._db.execute("PRAGMA journal_mode = DELETE").fetchall()
-            except sqlite3.Error:  # the log stays next to the file; the next open folds it in
-                pass
+        """Close, then fold the write-ahead log back into the store file (without waiting for readers).
+
+        The switch back to the rollback journal (one self-contained file: no ``-wal``/``-shm`` left for later
+        readers) is made on a connection of its own once this one is closed: on this one it can fail with "database
+        table is locked" after the integrity check of :meth:`open`.  A reader still attached keeps the store in WAL
+        mode, which is as safe (the next open folds the log in)."""
         self._db.close()
+        if str(self.path) == ":memory:" or self.read_only:
+            return
+        try:
+            with closing(sqlite3.connect(f"{self.path.resolve().as_uri()}?mode=rw", uri=True, timeout=0)) as db:
+                db.execute("PRAGMA journal_mode = DELETE").fetchall()
+        except sqlite3.Error:  # a reader attached, or the folder is gone: the log stays next to the file
+            pass
 
     def __enter__(self) -> CampaignStore:
         return self
