@@ -294,7 +294,7 @@ def _file_name(value: Any) -> Any:
     return value
 
 
-FileName = Annotated[str, BeforeValidator(_file_name), Field(max_length=NAME_MAX, pattern=r"^[A-Za-z0-9_.\-]+$")]
+FileName = Annotated[str, BeforeValidator(_file_name), Field(max_length=NAME_MAX)]
 """A name that becomes (part of) a file name: letters, digits, ``_``, ``-`` and ``.``, 1 to :data:`NAME_MAX`
 characters; refused on validation naming the field, never after the work when the file is written."""
 

@@ -70,7 +70,7 @@ def _constraints(field: Any) -> str:
     parts = []
     for meta in field.metadata:
         for attr, sign in (("gt", ">"), ("ge", "≥"), ("lt", "<"), ("le", "≤"), ("min_length", "min length"),
-                           ("pattern", "pattern")):
+                           ("max_length", "max length"), ("pattern", "pattern")):
             value = getattr(meta, attr, None)
             if value is not None:
                 parts.append(f"{sign} {value}")
@@ -106,10 +106,12 @@ def reference_markdown() -> str:
              "Generated from the config models by `railopt reference --out docs/config-reference.md`; do not edit "
              "by hand (a test compares this file with the models). How to write a study: "
              "[studies.md](studies.md); a first example: [tutorial.md](tutorial.md).", "",
-             "Every table refuses unknown keys; numbers are numbers (a string such as `\"1e5\"` is refused), counts "
-             "are integers, integers fit int64 (`seed`), `maxeval` fits a C int (at most 2147483647) and `n_starts` "
-             "is at most 10000000. Relative file paths in `[[models]].options` (`vehicle = \"car.toml\"`) are read "
-             "from the study file's folder.", ""]
+             "Every table refuses unknown keys (with a did-you-mean); numbers are numbers (a string such as "
+             "`\"1e5\"` is refused) and finite (`inf` and `nan` are refused), counts are integers, integers fit int64 "
+             "(`seed`), `maxeval` fits a C int (at most 2147483647) and `n_starts` is at most 10000000. Names that "
+             "become file names (the study's name, model labels, trade-off names) are letters, digits, `_`, `-` and "
+             "`.`, at most 100 characters. Relative file paths in `[[models]].options` (`vehicle = \"car.toml\"`) are "
+             "read from the study file's folder.", ""]
     for name, kind in sorted(discover_kinds().items()):
         lines += [f"## Kind `{name}`", ""]
         if kind.summary:

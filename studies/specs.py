@@ -186,9 +186,11 @@ class StabilitySpec(FiniteModel):
     @classmethod
     def _named(cls, v: list[str]) -> list[str]:
         for i, name in enumerate(v):
+            if not name:
+                raise ValueError(f"entry {i} is empty: an empty name is a prefix of every mode name and would leave "
+                                 "every root out of the constraint; name a mode, e.g. 'body hunting'")
             if not name.strip():
-                raise ValueError(f"entry {i} ({name!r}) is empty: an empty name is a prefix of every mode name and "
-                                 "would leave every root out of the constraint; name a mode, e.g. 'body hunting'")
+                raise ValueError(f"entry {i} is blank: it names no mode; name one, e.g. 'body hunting'")
         return v
 
     @model_validator(mode="after")

@@ -107,7 +107,8 @@ def catalog_entry(name: str, field_name: str = "model") -> CatalogEntry:
 class ModelRef(StrictModel):
     """``[[models]]`` entry of a study: a label, a registered model name and its options."""
 
-    label: FileName = Field(description="names the model's campaigns, stores and table rows (a file name)")
+    label: FileName = Field(description="names the model's campaigns, stores, files and table rows: letters, "
+                                        "digits, _, - and .")
     model: str
     options: dict[str, Any] = Field(default_factory=dict)
 

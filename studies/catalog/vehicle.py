@@ -27,7 +27,7 @@ from railopt.studies.catalog import (
     register_model,
 )
 from railopt.studies.catalog.views import stability_view, vehicle_view
-from railopt.studies.config import StrictModel
+from railopt.studies.config import StrictModel, not_one_of
 
 __all__ = [
     "VEHICLE", "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family",
@@ -36,14 +36,21 @@ __all__ = [
 ]
 
 VEHICLE = ("a bundled vehicle name (sd40-2, manchester-coach, single-wheelset) or a vehicle file path (relative "
-           "to the study file); required")
+           "to the study file)")
 """The description of the ``vehicle`` option of every vehicle model: required (a forgotten key never runs some
 default vehicle)."""
 
 
 def load(options):
-    """The vehicle of ``options`` (a bundled name or a file) with its ``parameters`` overrides."""
+    """The vehicle of ``options`` (a bundled name or a file) with its ``parameters`` overrides; an unknown override
+    is a ValueError ``"parameters.<name>: unknown parameter ...; did you mean ...?"``."""
     vehicle = load_vehicle(options.vehicle)
+    for name in options.parameters:
+        try:
+            vehicle.parameter(name)
+        except ValueError:
+            unknown = not_one_of(name, vehicle.parameter_names(), "parameter")
+            raise ValueError(f"parameters.{name}: {unknown} (vehicle {vehicle.name!r})") from None
     return vehicle.with_parameters(options.parameters) if options.parameters else vehicle
 
 

@@ -31,7 +31,7 @@ from railopt.models.units import FOOT, INCH, MPH
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.catalog import ModelsStudy, require_unique
 from railopt.studies.catalog.vehicle import VehicleForcedOptions, vehicle_forced_model
-from railopt.studies.config import BandHz, FiniteModel
+from railopt.studies.config import BandHz, FileName, FiniteModel
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_forced_response
 from railopt.studies.output.markdown import markdown_table
@@ -60,7 +60,7 @@ class BandSpec(FiniteModel):
     ``plot`` = false computes the band's responses and peaks without a figure.
     """
 
-    label: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    label: FileName
     band_hz: BandHz
     points: int = Field(300, ge=2, le=20_000, strict=True)
     spacing: Literal["linear", "log"] = "linear"
@@ -81,7 +81,7 @@ class GroupSpec(FiniteModel):
     models' speeds.
     """
 
-    label: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    label: FileName
     rigid: str = Field(description="label of the rigid-track model")
     flexible: str = Field(description="label of the flexible-track model")
     panels: list[PanelSpec] = Field(min_length=1)
@@ -130,6 +130,15 @@ class ForcedResponseConfig(ModelsStudy):
                         model.forced_system(irregularity, [p.output], p.quantity)
                     except ValueError as exc:
                         raise ValueError(f"groups[{gi}].panels[{pi}].output: {exc}") from None
+        figures: dict[str, str] = {}  # one file per figure: a second with the same name would overwrite the first
+        for gi, g in enumerate(self.groups):
+            for pi, p in enumerate(g.panels):
+                for b in g.bands:
+                    name, field = f"{g.label}_{_slug(p.output)}_{b.label}", f"groups[{gi}].panels[{pi}].output"
+                    if name in figures:
+                        raise ValueError(f"{field}: its figure {name}.png is also the figure of {figures[name]}; one "
+                                         "would overwrite the other (one panel per output and group)")
+                    figures[name] = field
         return self
 
 

@@ -18,7 +18,7 @@ from pydantic import Field, model_validator
 from railopt.models import all_response_maxima
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
-from railopt.studies.config import BandHz, FiniteModel
+from railopt.studies.config import BandHz, FileName, FiniteModel, not_one_of
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_frf_panels
 from railopt.studies.output.markdown import markdown_table
@@ -31,7 +31,7 @@ __all__ = ["DesignSpec", "FRFResult", "FRFStudyConfig", "GridSpec", "compute", "
 class DesignSpec(FiniteModel):
     """A design to evaluate: a named design of the model, or explicit values."""
 
-    label: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    label: FileName
     named: str | None = None
     values: dict[str, float] = Field(default_factory=dict)
 
@@ -51,9 +51,9 @@ class DesignSpec(FiniteModel):
             if self.named not in setup.named_designs:
                 raise ValueError(f"{where}.named: no named design {self.named!r}; known: {sorted(setup.named_designs)}")
             return dict(setup.named_designs[self.named])
-        bad = [k for k in self.values if k not in setup.designable]
-        if bad:
-            raise ValueError(f"{where}.values: {bad} are not parameters; choose from {list(setup.designable)}")
+        for k in self.values:
+            if k not in setup.designable:
+                raise ValueError(f"{where}.values.{k}: {not_one_of(k, setup.designable, 'parameter')}")
         setup.parameter_map.check_values(self.values, f"{where}.values")
         return dict(self.values)
 

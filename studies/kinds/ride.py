@@ -37,7 +37,7 @@ from railopt.models.random_response import _check_spectrum_band, output_psd, ran
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.adapter import ResponseTarget, RMSTarget, minimax_problem
 from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
-from railopt.studies.config import BandHz, FiniteModel
+from railopt.studies.config import BandHz, FileName, FiniteModel
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_frf_panels
 from railopt.studies.output.markdown import markdown_table
@@ -54,7 +54,7 @@ DESIGNS = ("existing", "minimax_sinusoid", "rms_random")
 class RideCase(FiniteModel):
     """One output of one model: its band, spectrum, comfort direction and design variables."""
 
-    label: str = Field(pattern=r"^[A-Za-z0-9_.\-]+$")
+    label: FileName
     model: str = Field(description="label of a [[models]] entry (a vehicle_forced model)")
     output: str = Field(description="an acceleration output, e.g. body[6,0.8,1.0].z or cab.lateral")
     direction: Literal["vertical", "lateral"] = Field(
@@ -110,11 +110,7 @@ def _check_case(case: RideCase, setup: ModelSetup, where: str, model: str) -> No
                          "(set options.quantity = 'acceleration')")
     names = [v.name for v in case.variables]
     require_unique(f"{where}.variables", names)
-    bad = [n for n in names if n not in setup.designable]
-    if bad:
-        raise ValueError(f"{where}.variables: {bad} are not parameters of {model}; choose from "
-                         f"{list(setup.designable)}")
-    setup.parameter_map.check_variables(case.variables, f"{where}.variables")
+    setup.parameter_map.check_variables(case.variables, f"{where}.variables", model)  # names (did-you-mean), bounds
     try:
         _check_spectrum_band(case.spectrum.spectrum(), setup.family.speed, tuple(case.band_hz))
     except ValueError as exc:

@@ -93,6 +93,12 @@ class SpeedSweepConfig(ModelsStudy):
 
     @model_validator(mode="after")
     def _resolve(self) -> SpeedSweepConfig:
+        slugs = [_slug(ref.label) for ref in self.models]  # each model's mode figure, modes_<label>.png
+        for i, slug in enumerate(slugs):
+            if slug in slugs[:i]:
+                raise ValueError(f"models[{i}].label: its figure modes_{slug}.png is also that of "
+                                 f"models[{slugs.index(slug)}]; give the models labels that differ in more than "
+                                 "'.' and '_'")
         for i, ref in enumerate(self.models):
             setup = ref.setup(f"models[{i}]")
             if not setup.stability:
@@ -110,10 +116,11 @@ def _variant(ref: ModelRef, parameter: str, factor: float, where: str, at: str |
     if "parameters" not in type(options).model_fields:
         raise ValueError(f"{where}.parameter: model {ref.model!r} takes no parameter overrides")
     vehicle = load(options)
-    names = vehicle.parameter_names()
-    if parameter not in names:
-        raise ValueError(f"{where}.parameter: {not_one_of(parameter, names, 'parameter')} (vehicle {vehicle.name!r})")
-    base = vehicle.parameter(parameter)
+    try:
+        base = vehicle.parameter(parameter)
+    except ValueError:
+        unknown = not_one_of(parameter, vehicle.parameter_names(), "parameter")
+        raise ValueError(f"{where}.parameter: {unknown} (vehicle {vehicle.name!r})") from None
     changed = {**options.parameters, parameter: factor * base}
     variant = ref.model_copy(update={"options": {**ref.options, "parameters": changed}})
 

@@ -27,7 +27,8 @@ def test_reference_documents_every_kind_and_catalog_model_with_types_and_default
     # a few rows, whole: field, type, default, description
     assert "| `seed` | int | 0 | ≥ 0; at most 9223372036854775807 |" in text
     assert "| `n_starts` | int | 16 | > 0; at most 10000000 |" in text
-    assert ('| `vehicle` | str | "sd40-2" | a bundled vehicle name or a vehicle file path |') in text
+    assert ('| `vehicle` | str | required | a bundled vehicle name (sd40-2, manchester-coach, single-wheelset) or a '
+            'vehicle file path (relative to the study file) |') in text  # no default vehicle (issue 27, item 2)
     assert "| `mass_ratio` | float | required | absorber / primary mass (> 0, ≤ 10) |" in text
 
 

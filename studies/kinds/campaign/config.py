@@ -416,7 +416,10 @@ def _check_exclude(spec, families: dict, required: float, where: str) -> None:
                                  f"at {speed:g} m/s: the stability constraint would constrain nothing")
         for speed in (speeds[0], speeds[-1]):
             table = modes(family, speed=speed)
-            names |= set(table["name"]) | set(table["group"])
+            names |= set(table["group"])
+            for name in table["name"]:  # each name and its leading words ("body hunting" of "body hunting (...)")
+                words = name.split()
+                names |= {" ".join(words[:k]) for k in range(1, len(words) + 1)}
     for i, entry in enumerate(spec.exclude):
         if not matched[i]:
             unknown = not_one_of(entry, sorted(names), "mode name")

@@ -20,7 +20,13 @@ from railopt.studies.adapter import (
     stability_target,
 )
 from railopt.studies.catalog import Check, ModelSetup
-from railopt.studies.kinds.campaign.config import CampaignStudyConfig, ConstraintSpec, StabilitySpec, TradeoffSpec
+from railopt.studies.kinds.campaign.config import (  # campaign_label: the config checks the stores' names too
+    CampaignStudyConfig,
+    ConstraintSpec,
+    StabilitySpec,
+    TradeoffSpec,
+    campaign_label,
+)
 
 __all__ = ["MEASURES", "FeasibleDesign", "campaign_label", "campaign_problem", "design_peak", "design_value",
            "measure_label", "measure_target", "reported_measures", "section_objective", "study_measures"]
@@ -30,12 +36,6 @@ MEASURES: dict[str, str] = {"thesis": "peak", "exact": "peak", "rms": "rms"}
 of |H| under the sinusoid (the thesis objective is judged by the maximum it approximates), or ``rms``, the RMS per
 metre of irregularity under ``[objective.spectrum]``.  A campaign's headline, before/after and tables are in the
 measure of the objective it minimised; the other measure is a side column."""
-
-
-def campaign_label(model: str, objective: str, method: str, problem: str = "constrained") -> str:
-    """The store name of a campaign: ``<model>-<objective>-<method>``, with ``-unconstrained`` after the model for
-    the unconstrained problem of a study that has constraints."""
-    return f"{model}-{objective}-{method}" if problem == "constrained" else f"{model}-{problem}-{objective}-{method}"
 
 
 def campaign_problem(cfg: CampaignStudyConfig, setup: ModelSetup, objective: str, problem: str = "constrained",
