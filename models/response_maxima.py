@@ -10,17 +10,22 @@ boundaries are the midpoints between consecutive clipped ω_dj, and f_j is the m
 over cell j.  The union of the cells is the band, so ``max_k f_k`` *is* the band maximum, and
 each f_j is still continuous in the design.  Each cell is sampled on a grid whose step never
 exceeds ``GRID_FACTOR`` times the distance from iΩ to the nearest pole of H, nor GRID_FACTOR times
-a quarter period 2π/(4τ_max) of the largest declared delay in F; the best sample is refined by
-golden-section search between its neighbours, and the reported value is a direct solve
-``Z(Ω)X = F`` at the refined frequency.  H is sampled in pole–residue form (O(n) per frequency)
-when the eigenvector matrix is well conditioned (:data:`~railopt.models.pole_residue.CONDITION_LIMIT`),
-by direct solves otherwise.
+a quarter period 2π/(4τ_max) of the largest declared delay in F; every sampled local maximum within 10 % of
+its cell's best sample is refined between its neighbours (:func:`~railopt.models.peak_search.cell_maxima`), and
+the reported value is a direct solve ``Z(Ω)X = F`` at the refined frequency.  H is sampled in pole–residue form
+(O(n) per frequency) when the eigenvector matrix is well conditioned
+(:data:`~railopt.models.pole_residue.CONDITION_LIMIT`), by direct solves otherwise.  Free rigid-body roots make
+Z(Ω) singular to rounding near Ω = 0: below :class:`ZeroZone`'s step H is a limit model.
 
-``certified`` is a resolution certificate, not an interval proof: the spacing rule held at every
-step, every sample was finite, and every delay in F was declared (a plain callable forcing is
-never certified).  Between two poles a rational |H| cannot rise and fall within a quarter of the
-distance to the nearest pole, and a delayed term cannot within a sixteenth of its period, so the
-sampled maximum lies in the basin of the true one.
+``certified`` means U is the band maximum to :data:`CERTIFIED_RTOL` (1e-8 relative).  It is a resolution
+certificate, not an interval proof: the spacing rule held at every step, every sample was finite, every delay in F
+was declared (a plain callable forcing is never certified) and every candidate was refined.  Between two poles a
+rational |H| cannot rise and fall within a quarter of the distance to the nearest pole, and a delayed term cannot
+within a sixteenth of its period, so each true local maximum has a sample within a few per cent of its top.  Where
+that cannot be vouched for — a mode undamped to rounding (ζ ≤ 1e-12, reported as inf), a pole whose damping is
+within the rounding of its eigenvalue (defective or nearly repeated pairs), a mode too soft to be told from
+rigid-body motion, a delay whose grid would exceed :data:`MAX_GRID_POINTS`, a limit at 0 known less well than
+1e-8 where it may be the maximum — ``certified`` is False and ``reason`` says why.
 """
 
 from __future__ import annotations
@@ -48,8 +53,8 @@ MIN_CELL_SAMPLES = 8
 MAX_GRID_POINTS = 200_000
 CONSISTENCY_RTOL = 1e-6  # pole–residue vs direct value at a refined maximum; beyond it, redo by direct solves
 
-__all__ = ["ResponseMaxima", "ZeroZone", "all_response_maxima", "band_grid", "peak", "response_maxima", "validate_band",
-           "zero_zone"]
+__all__ = ["CERTIFIED_RTOL", "ResponseMaxima", "ZeroZone", "all_response_maxima", "band_grid", "peak",
+           "response_maxima", "validate_band", "zero_zone"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -70,8 +75,9 @@ class ResponseMaxima(ArrayRecord):
     exact : bool
         Whether the cell maxima of the exact method were used.
     certified : bool
-        Exact method only: the grid met the spacing rule everywhere, no sample was singular and
-        the forcing declared its delays.
+        Exact method only: U is the band maximum to CERTIFIED_RTOL (1e-8 relative) — the grid met the spacing
+        rule everywhere, no sample was singular, the forcing declared its delays and every pole was resolved
+        (see the module docstring; ``reason`` says why not).
     grid_ratio : float
         Exact method only: the largest grid step / distance to the nearest pole (certified when
         ≤ CERTIFIED_RATIO).
@@ -169,7 +175,13 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
                         band_rad_s: tuple[float, float] | None = None, exact: bool = False,
                         outputs: list[str] | None = None) -> dict[str, ResponseMaxima]:
     """f_k of several outputs sharing one eigen-decomposition and one frequency grid; the band as
-    ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s), see :func:`railopt.models.validation.band_arg`."""
+    ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s), see :func:`railopt.models.validation.band_arg`.
+
+    Returns ``{output: ResponseMaxima}`` (n + 2 values each).  An unstable system gives +inf everywhere with the
+    reason; an undamped mode in the band (ζ ≤ 1e-12) an inf entry; a lower edge below the rigid-body zone's step
+    (:func:`zero_zone`) the limit model's value.  Raises ``ValueError`` naming ``band`` for a band from 0 Hz where
+    an output grows without bound (free rigid-body motion), or naming an unknown output.
+    """
     lo, hi = band_arg(band, band_hz, band_rad_s)
     names = list(system.output_names if outputs is None else outputs)
     cols = [system.output_index(nm) for nm in names]
