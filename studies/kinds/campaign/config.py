@@ -235,8 +235,16 @@ def output_files(cfg: CampaignStudyConfig) -> list[tuple[str, str]]:
     """``(file name, field that names it)`` of every file a run of ``cfg`` may write: the campaign stores
     (``campaigns/<label>.sqlite``), the per-model before/after, trade-off and surface files.  Two entries with the
     same file name would overwrite each other."""
-    files: list[tuple[str, str]] = []
+    own = "the report's own files"
+    files: list[tuple[str, str]] = [(f"{stem}.{ext}", own) for stem, ext in (
+        ("comparison", "csv"), ("starts", "csv"), ("starts", "parquet"), ("outcomes", "csv"), ("optima", "csv"),
+        ("frf", "png"), ("recommended", "csv"), ("timing", "csv"))]
     d = cfg.design
+    for ref in cfg.models:
+        tag = model_tag(ref.label, len(cfg.models))
+        files += [(f"{stem}{tag}.{ext}", own) for stem, ext in (
+            ("before_after", "csv"), ("stability", "csv"), ("root_locus_before_after", "csv"),
+            ("root_locus_before_after", "png"))]
     for i, ref in enumerate(cfg.models):
         for prob in d.problems:
             for objective, method in d.plan(prob):
