@@ -348,6 +348,8 @@ def publication(results: Path | str, study: str, flag: str = "--results") -> Ite
     beside = ensure_folder(home.parent)
     check_writable(root, beside, home, home / CAMPAIGNS)  # before hours of work, not when publishing
     existed = home.exists()
+    if final.is_symlink() and not existed:  # a dangling link (its folder deleted): the stores go where it points
+        ensure_folder(home)
     with study_lock(root, study):
         clear_leftovers(root, study)
         if (beside, home.name) != (root, study):

@@ -7,6 +7,7 @@ process — on the bundled ``tmd_hinf`` study cut down to one campaign of a few 
 from __future__ import annotations
 
 import os
+import shutil
 import sqlite3
 import stat
 import subprocess
@@ -16,8 +17,11 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from railopt.models.track.spectra import irregularity_spectrum
+from railopt.models.vehicle.loader import bundled_path
 from railopt.studies.cli import STUDIES_DIR
 
 STUDY = "tmd_hinf"
@@ -151,3 +155,63 @@ def baseline_fixtures(n_starts: int):
         return Path(shutil.copytree(published[1], tmp_path / "results"))
 
     return published, results
+
+
+INPUTS = "ride_inputs"
+INPUTS_LABEL = "coach-rms-slsqp"
+SEAT = "body[6,0.8,1.0].z"
+
+
+def inputs_study(folder: Path, n_starts: int = 1) -> Path:
+    """A campaign on a vehicle file of its own (``coach.toml``, a copy of the bundled coach) under a measured
+    spectrum of its own (``psd.csv``: the ERRI B176 low profile tabulated at 60 wavenumbers)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(bundled_path("manchester-coach"), folder / "coach.toml")
+    erri = irregularity_spectrum("erri_b176", level="low", component="profile")
+    w = np.geomspace(0.021, 6.28, 60)
+    np.savetxt(folder / "psd.csv", np.column_stack([w, erri.psd(w)]), delimiter=",",
+               header="wavenumber_rad_per_m,psd_m2_per_rad_per_m", comments="")
+    study = folder / "study.toml"
+    study.write_text(f"""
+[study]
+name = "{INPUTS}"
+kind = "campaign"
+
+[[models]]
+label = "coach"
+model = "vehicle_forced"
+
+[models.options]
+vehicle = "coach.toml"
+view = "vertical"
+speed_m_s = 40.0
+input = {{ kind = "vertical", amplitude_m = 0.01 }}
+outputs = ["{SEAT}"]
+quantity = "acceleration"
+
+[objective]
+output = "{SEAT}"
+band_hz = [0.5, 20.0]
+spectrum = {{ standard = "table", path = "{folder / 'psd.csv'}" }}
+
+[design]
+objectives = ["rms"]
+methods = ["slsqp"]
+n_starts = {n_starts}
+
+[design.options]
+maxeval = 4
+
+[[design.variables]]
+name = "secondary_vertical_stiffness"
+lower = 1e5
+upper = 2e6
+scale = "log"
+
+[[design.variables]]
+name = "secondary_vertical_damping"
+lower = 1e3
+upper = 1e5
+scale = "log"
+""")
+    return study

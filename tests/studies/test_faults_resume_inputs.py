@@ -12,7 +12,6 @@ first starts of the config (a lowered ``n_starts``, ``lhs`` drawing anew) is ref
 from __future__ import annotations
 
 import hashlib
-import shutil
 import sqlite3
 from pathlib import Path
 
@@ -20,6 +19,8 @@ import numpy as np
 import pandas as pd
 import pytest
 from faults_cli import (
+    INPUTS,
+    INPUTS_LABEL,
     STUDY,
     assert_refused,
     cli,
@@ -29,72 +30,13 @@ from faults_cli import (
     store_path,
     study_file,
 )
+from faults_cli import inputs_study as _inputs_study
 
-from railopt.models.track.spectra import irregularity_spectrum
 from railopt.models.vehicle.loader import bundled_path
 from railopt.studies.cli import STUDIES_DIR, main
 from railopt.studies.config import load_study
 from railopt.studies.kinds.campaign import stores as stores_module
 from railopt.studies.kinds.campaign.stores import input_digests, input_files
-
-INPUTS = "ride_inputs"
-INPUTS_LABEL = "coach-rms-slsqp"
-SEAT = "body[6,0.8,1.0].z"
-
-
-def _inputs_study(folder: Path, n_starts: int = 1) -> Path:
-    """A campaign on a vehicle file of its own (``coach.toml``, a copy of the bundled coach) under a measured
-    spectrum of its own (``psd.csv``: the ERRI B176 low profile tabulated at 60 wavenumbers)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(bundled_path("manchester-coach"), folder / "coach.toml")
-    erri = irregularity_spectrum("erri_b176", level="low", component="profile")
-    w = np.geomspace(0.021, 6.28, 60)
-    np.savetxt(folder / "psd.csv", np.column_stack([w, erri.psd(w)]), delimiter=",",
-               header="wavenumber_rad_per_m,psd_m2_per_rad_per_m", comments="")
-    study = folder / "study.toml"
-    study.write_text(f"""
-[study]
-name = "{INPUTS}"
-kind = "campaign"
-
-[[models]]
-label = "coach"
-model = "vehicle_forced"
-
-[models.options]
-vehicle = "coach.toml"
-view = "vertical"
-speed_m_s = 40.0
-input = {{ kind = "vertical", amplitude_m = 0.01 }}
-outputs = ["{SEAT}"]
-quantity = "acceleration"
-
-[objective]
-output = "{SEAT}"
-band_hz = [0.5, 20.0]
-spectrum = {{ standard = "table", path = "{folder / 'psd.csv'}" }}
-
-[design]
-objectives = ["rms"]
-methods = ["slsqp"]
-n_starts = {n_starts}
-
-[design.options]
-maxeval = 4
-
-[[design.variables]]
-name = "secondary_vertical_stiffness"
-lower = 1e5
-upper = 2e6
-scale = "log"
-
-[[design.variables]]
-name = "secondary_vertical_damping"
-lower = 1e3
-upper = 1e5
-scale = "log"
-""")
-    return study
 
 
 def _published(folder: Path) -> dict[str, bytes]:

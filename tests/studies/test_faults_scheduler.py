@@ -1,14 +1,34 @@
-"""Fault tests of the dask scheduler choice: a dead scheduler fails fast by name; flags beat the environment."""
+"""Fault tests of the dask scheduler choice: a dead scheduler fails fast by name; flags beat the environment; a
+worker lost on an external cluster is said, and ``timing.csv`` records the workers at the start and the end."""
 
 from __future__ import annotations
 
+import os
+import signal
+import socket
+import subprocess
+import sys
 import time
 
 import dask
 import distributed  # noqa: F401  (its config holds the connect timeout)
+import pandas as pd
 import pytest
+from dask.distributed import Client
 from dask.utils import parse_timedelta
-from faults_cli import STUDY, assert_refused, cli, env, run_args, start_rows, store_path, study_file
+from faults_cli import (
+    STUDY,
+    assert_refused,
+    cli,
+    count_starts,
+    env,
+    run_args,
+    start,
+    start_rows,
+    store_path,
+    study_file,
+    wait_until,
+)
 
 from railopt.studies.cli import main
 
@@ -75,3 +95,53 @@ def test_bad_scheduler_flags_are_named(extra, environ, named, study, tmp_path, m
     err = capsys.readouterr().err
     assert err.startswith("railopt: error:") and err.count("\n") == 1 and named in err, err
     assert not results.exists() or list(results.iterdir()) == []  # nothing written, lock released
+
+
+# ---------------------------------------------------------------------------------------------- a lost worker (item 14)
+def _own_session(*args: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True, env=env())
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(300)
+def test_a_worker_lost_on_an_external_cluster_is_said_and_timing_records_the_workers(tmp_path):
+    """An external cluster of two workers (no nanny: a killed worker stays dead) loses one while the campaign runs:
+    the run finishes with every start once, says that the worker left and its tasks were re-run, and ``timing.csv``
+    records 2 workers at the start, 1 at the end, 2 at most, 1 lost."""
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    procs = [_own_session("distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+                          "--no-dashboard")]
+    try:
+        procs += [_own_session("distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
+                               "--no-dashboard", "--host", "127.0.0.1") for _ in range(2)]
+        with Client(address, timeout=30) as client:
+            client.wait_for_workers(2, timeout=60)
+        study = study_file(tmp_path / "study", 200)
+        results = tmp_path / "results"
+        run = start(*run_args(study, results, "--scheduler", address, "--scheduler-timeout", "30", workers=None))
+        assert wait_until(run, lambda: count_starts(store_path(results)) >= 5), run.communicate()
+        os.killpg(procs[1].pid, signal.SIGKILL)  # one worker, started by this test in its own session
+        out, err = run.communicate(timeout=240)
+    finally:
+        for proc in procs:
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert run.returncode == 0, err
+    assert [r[0] for r in start_rows(store_path(results))] == list(range(201))  # every start once
+    timing = pd.read_csv(results / STUDY / "timing.csv").iloc[0]
+    assert (timing["workers_at_start"], timing["workers_at_end"], timing["workers_max"]) == (2, 1, 2)
+    assert timing["workers_lost"] == 1 and timing["tasks_rerun"] >= 1
+    notes = [line for line in err.splitlines() if line.startswith("railopt: note: ")]
+    assert notes == [f"railopt: note: {timing['cluster_events']}"], err
+    assert f"1 dask worker left the cluster {address} during the run" in notes[0]
+    rerun = int(timing["tasks_rerun"])
+    assert f"{rerun} task{' was' if rerun == 1 else 's were'} re-run on other workers" in notes[0]
