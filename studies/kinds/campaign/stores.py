@@ -257,7 +257,7 @@ def _campaign(cfg: CampaignStudyConfig, setup: ModelSetup, key: tuple[str, str, 
     found = distinct_optima(table, problem).rename(columns={"best_start": "start_id"})
     flags: list[str] = []
     for check in cfg.design.checks:  # a check of each distinct optimum (a critical-speed search: seconds each)
-        bar = Progress(f"{label}: {check} check of the optima", unit="design", enabled=context.show_progress)
+        bar = Progress(f"{label} ({check} check of its optima)", unit="design", enabled=context.show_progress)
         with reporting_progress(bar.update):
             found, check_flags = check_optima(found, setup, names, label, context, check, client)
         bar.close()
