@@ -217,7 +217,7 @@ def test_summary_reports_before_after_and_flags(flagship):
                                                                                     output="cab_acceleration")
     assert U == pytest.approx(float(rec.iloc[0]["U"]), rel=1e-9)
     summary = (out / "summary.md").read_text()
-    assert summary.index("## Recommended design: sd40-2") < summary.index("| model | problem |")
+    assert summary.index("## Recommended design: sd40-2") < summary.index("| model | vehicle | problem |")
 
 
 @pytest.mark.slow

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from railopt.studies.kinds.campaign.config import surface_stem, tradeoff_stem
 from railopt.studies.kinds.campaign.problems import MEASURES, measure_label
 from railopt.studies.kinds.campaign.run import CampaignResult
 from railopt.studies.kinds.campaign.sections import (
@@ -214,7 +215,7 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
 
 def _tradeoff(result: CampaignResult, s: ModelSections, t: Tradeoff, writer: Writer) -> list[str]:
     names = [v.name for v in result.config.design.variables]
-    stem, q, spec = f"{t.spec.name}{s.tag}", t.quantity, t.spec
+    stem, q, spec = tradeoff_stem(t.spec.name, s.tag), t.quantity, t.spec
     writer.table(_csv(result, t.table, s.model), f"tradeoff_{stem}")
     writer.table(_csv(result, t.front, s.model), f"pareto_{stem}")
     writer.figure(plot_tradeoff(t.table, q, f"{s.model}: U against {q} ({spec.name})", required=t.required),
@@ -269,7 +270,7 @@ def tradeoffs_section(result: CampaignResult, s: ModelSections, writer: Writer) 
 
 def _surface(result: CampaignResult, s: ModelSections, g: TradeoffSurfaces, writer: Writer) -> list[str]:
     a, b = g.spec.variables
-    stem = f"surface_{a}_{b}{s.tag}"
+    stem = surface_stem((a, b), s.tag)
     writer.table(_csv(result, g.constrained.to_pandas(), s.model), f"{stem}_constrained")
     writer.table(_csv(result, g.unconstrained.to_pandas(), s.model), f"{stem}_unconstrained")
     for bd in g.boundaries:

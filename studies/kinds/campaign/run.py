@@ -15,7 +15,7 @@ import pandas as pd
 
 from railopt.design.parallel import reporting_progress
 from railopt.studies.kind import StudyContext, dask_context
-from railopt.studies.kinds.campaign.config import CampaignStudyConfig
+from railopt.studies.kinds.campaign.config import CampaignStudyConfig, model_tag
 from railopt.studies.kinds.campaign.problems import _p, campaign_label
 from railopt.studies.kinds.campaign.sections import ModelSections, _comparison_row, _frf_panels, _model_sections, _short
 from railopt.studies.kinds.campaign.selection import _recommend
@@ -84,7 +84,7 @@ def compute(config: CampaignStudyConfig, context: StudyContext) -> CampaignResul
                 bar = Progress(f"{m}: trade-offs, surfaces and checks", unit="task", enabled=context.show_progress)
                 with reporting_progress(bar.over_maps()):
                     sections.append(_model_sections(cfg, m, s, comparison, tables,
-                                                    "" if len(setups) == 1 else f"_{m}", client, recommended[m]))
+                                                    model_tag(m, len(setups)), client, recommended[m]))
                 bar.close()
     starts = pd.concat([t.drop(columns=["functions"], errors="ignore").assign(model=m, problem=prob, objective=o,
                                                                              method=meth)
