@@ -310,7 +310,8 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame, max_hz: float =
         if (d["damping_ratio"] < 0).any():
             unstable = d[d["damping_ratio"] < 0]
             named = ", ".join(dict.fromkeys(unstable["name"])) if "name" in unstable else ""
-            _locus_panels(ax_z, ax_f, unstable, max_hz, "C3", "o", f"roots, ζ < 0{': ' + named if named else ''}")
+            label = wrap_title(f"roots, ζ < 0{': ' + named if named else ''}", width - 2.5, 7)  # within the panel
+            _locus_panels(ax_z, ax_f, unstable, max_hz, "C3", "o", label)
         cs = critical[critical["model"] == m].iloc[0]
         vehicle = cs.get("vehicle", "")
         title = (f"{m}{f' — {vehicle}' if isinstance(vehicle, str) and vehicle else ''}: critical speed "
@@ -322,7 +323,7 @@ def plot_root_locus(locus: pd.DataFrame, critical: pd.DataFrame, max_hz: float =
                 ax.axvline(cs["critical_speed_m_s"], color="k", ls="--", lw=0.9,
                            label="critical speed" if ax is ax_z else None)
         _locus_axes(ax_z, ax_f, max_hz, _below(d, max_hz))
-        ax_z.set_title(wrap_title(title, width - 1.0, 9), fontsize=9)
+        ax_z.set_title(wrap_title(title, width - 2.0, 9), fontsize=9)  # the axes, not the figure column, is the width
         ax_z.legend(fontsize=7, markerscale=3, loc="lower left")
         hidden = _off_chart(d, max_hz)
         if hidden:

@@ -128,7 +128,8 @@ def test_a_spectrum_csv_with_a_byte_order_mark_loads_every_row(header, tmp_path)
     """The issue's file: a spreadsheet's "CSV UTF-8" (a byte-order mark) without a header; its first row was
     taken for a header and dropped.  With a header the header goes, the rows stay."""
     rows = _rows()
-    text = ("wavenumber (rad/m),PSD (m²/(rad/m))\n" if header else "") + "\n".join(f"{w!r},{s!r}" for w, s in rows.tolist())
+    head = "wavenumber (rad/m),PSD (m²/(rad/m))\n" if header else ""
+    text = head + "\n".join(f"{w!r},{s!r}" for w, s in rows.tolist())
     path = tmp_path / "psd.csv"
     path.write_bytes(b"\xef\xbb\xbf" + text.encode())
     spectrum = read_spectrum_table(path)
