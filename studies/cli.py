@@ -33,11 +33,11 @@ from railopt.studies.config import ConfigError, load_study, read_toml
 from railopt.studies.kind import StudyKind
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.publish import ResultsError, check_writable, ensure_folder, results_root
-from railopt.studies.run_study import STUDIES_DIR, execute_study, resolve_study, run_timing
+from railopt.studies.run_study import STUDIES_DIR, execute_study, resolve_study, run_timing, study_warnings
 
 __all__ = [
     "STUDIES_DIR", "build_parser", "check_number", "cmd_bench", "cmd_list", "cmd_reference", "cmd_run", "cmd_validate",
-    "cmd_vehicle", "main", "main_vehicle", "print_warnings", "resolve_study", "run_timing",
+    "cmd_vehicle", "main", "main_vehicle", "print_warnings", "resolve_study", "run_timing", "study_warnings",
 ]
 
 EXIT_USAGE = 2
@@ -52,7 +52,7 @@ WORKERS_PER_CPU = 16  # --workers above this many per CPU is a slip: each worker
 
 def print_warnings(kind: StudyKind, config: object, study_file: Path | str) -> list[str]:
     """Print the kind's warnings on ``config`` as ``railopt: warning: FILE: message`` (stderr); returns them."""
-    messages = list(kind.warnings(config)) if kind.warnings is not None else []
+    messages = study_warnings(kind, config)
     for message in messages:
         print(f"railopt: warning: {study_file}: {' '.join(str(message).split())}", file=sys.stderr)
     return messages

@@ -37,10 +37,18 @@ from railopt.studies.kind import StudyContext, StudyKind
 from railopt.studies.output.publish import publication
 from railopt.studies.output.writer import Writer
 
-__all__ = ["STUDIES_DIR", "StudyRun", "execute_study", "resolve_study", "run_study", "run_timing"]
+__all__ = ["STUDIES_DIR", "StudyRun", "execute_study", "resolve_study", "run_study", "run_timing", "study_warnings"]
 
 STUDIES_DIR = Path(__file__).resolve().parent
 """The bundled studies' folder (``railopt list``)."""
+
+
+def study_warnings(kind: StudyKind, config: object) -> list[str]:
+    """Everything a study does not refuse but its user must hear of: the plausibility warnings of its vehicles
+    (each naming the file, the key and the likely slip), then the kind's own (an existing design that hunts)."""
+    from railopt.studies.catalog.vehicle import vehicle_warnings
+
+    return vehicle_warnings(config) + (list(kind.warnings(config)) if kind.warnings is not None else [])
 
 
 def resolve_study(arg: str) -> Path:
@@ -271,7 +279,7 @@ def run_study(path: str | Path, *, results: str | Path | None = None, workers: i
         checked_timeout(scheduler_timeout, "scheduler_timeout")
     study_file = resolve_study(str(path))
     kind, config, _ = load_study(study_file)
-    messages = [" ".join(str(m).split()) for m in (kind.warnings(config) if kind.warnings is not None else [])]
+    messages = [" ".join(str(m).split()) for m in study_warnings(kind, config)]
     for message in messages:
         warnings.warn(f"{study_file}: {message}", UserWarning, stacklevel=2)
     root = Path(tempfile.mkdtemp(prefix="railopt-")) if results is None else results

@@ -32,7 +32,7 @@ from railopt.studies.config import StrictModel, not_one_of
 __all__ = [
     "VEHICLE", "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family",
     "load", "physical_limits", "readable_aliases", "tracks_of", "vehicle_forced_model", "vehicle_forced_setup",
-    "vehicle_lateral_setup", "vehicle_setup",
+    "vehicle_lateral_setup", "vehicle_setup", "vehicle_warnings",
 ]
 
 VEHICLE = ("a bundled vehicle name (sd40-2, manchester-coach, single-wheelset) or a vehicle file path (relative "
@@ -52,6 +52,32 @@ def load(options):
             unknown = not_one_of(name, vehicle.parameter_names(), "parameter")
             raise ValueError(f"parameters.{name}: {unknown} (vehicle {vehicle.name!r})") from None
     return vehicle.with_parameters(options.parameters) if options.parameters else vehicle
+
+
+def vehicle_warnings(config: object) -> list[str]:
+    """The plausibility warnings (:func:`railopt.models.vehicle.plausibility`) of every vehicle a study's
+    ``[[models]]`` name, with its ``parameters`` applied, as ``"models[i] (<label>): <file>: <key>: <message>"``
+    lines — each vehicle (source and overrides) once.  A config without ``models``, or models without a vehicle
+    (``tmd``), gives none; a model that cannot be built is left to the run's own error."""
+    from railopt.models.vehicle.plausibility import plausibility
+
+    out, seen = [], set()
+    for i, ref in enumerate(getattr(config, "models", None) or []):
+        try:
+            options = ref.validated_options(f"models[{i}]")
+        except ValueError:
+            continue
+        source = getattr(options, "vehicle", None)
+        key = (source, tuple(sorted((getattr(options, "parameters", None) or {}).items())))
+        if not isinstance(source, str) or key in seen:
+            continue
+        seen.add(key)
+        try:
+            vehicle = load(options)
+        except ValueError:
+            continue
+        out += [f"models[{i}] ({ref.label}): {w.line()}" for w in plausibility(vehicle)]
+    return out
 
 
 def lateral_family(vehicle, track: str, names: Sequence[str], view: str = "lateral") -> ParametricSystem:

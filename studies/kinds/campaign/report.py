@@ -21,6 +21,7 @@ from railopt.studies.kinds.campaign.sections import (
     OUTCOMES,
     BeforeAfter,
     ModelSections,
+    figure_title,
     model_vehicles,
     outcome_counts,
     start_outcomes,
@@ -192,7 +193,8 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
            f"(4.71)–(4.73) reads {ba.thesis:.5g} at this optimum against the certified maximum {ba.exact:.5g} "
            f"({100 * (ba.thesis - ba.exact) / ba.exact:+.2f} %).", ""]
     for o, f_hz, before, after, unit in ba.frfs:
-        fig = plot_before_after(f_hz, before, after, f"{model}: {o} before and after optimisation", unit)
+        fig = plot_before_after(f_hz, before, after, figure_title(cfg, model, f"{o} before and after optimisation"),
+                                unit)
         name = writer.figure(fig, f"{o}_before_after{tag}", dpi=dpi)
         md += [f"![{o}]({name})", ""]
     if ba.stability is not None:
@@ -205,7 +207,11 @@ def before_after_section(result: CampaignResult, s: ModelSections, writer: Write
         md += ["Stability before and after (every distinct optimum's checks are in `optima.csv`):", "",
                markdown_table(shown, digits=5, infinite=texts), ""]
     if ba.loci is not None:
-        fig = plot_root_loci_before_after(ba.loci, f"{model}: velocity root loci before and after (rigid track)")
+        tracks = " and ".join(dict.fromkeys(t for d in ba.loci.values() for t in d["track"]))
+        required = cfg.stability.required(setup) if cfg.stability is not None else setup.required_speed
+        fig = plot_root_loci_before_after(
+            ba.loci, figure_title(cfg, model, f"velocity root loci before and after ({tracks} track)"),
+            required_speed=required)
         name = writer.figure(fig, f"root_locus_before_after{tag}", dpi=dpi)
         writer.table(_csv(result, pd.concat([d.assign(design=k) for k, d in ba.loci.items()]), model),
                      f"root_locus_before_after{tag}")
@@ -218,7 +224,12 @@ def _tradeoff(result: CampaignResult, s: ModelSections, t: Tradeoff, writer: Wri
     stem, q, spec = tradeoff_stem(t.spec.name, s.tag), t.quantity, t.spec
     writer.table(_csv(result, t.table, s.model), f"tradeoff_{stem}")
     writer.table(_csv(result, t.front, s.model), f"pareto_{stem}")
-    writer.figure(plot_tradeoff(t.table, q, f"{s.model}: U against {q} ({spec.name})", required=t.required),
+    setup = result.config.setups()[s.model]
+    u_label = f"U: {measure_label(result.config, setup, s.measure)}"
+    writer.figure(plot_tradeoff(t.table, q, figure_title(result.config, s.model, f"U against {q} ({spec.name})"),
+                                required=t.required, u_label=u_label,
+                                recommended=s.recommended.values if s.recommended is not None else None,
+                                targets=spec.epsilons),
                   f"pareto_{stem}", dpi=result.config.report.dpi)
     how = ("the constrained problem solved with the stability rows required up to each speed"
            if spec.check == "hunting" else "the constrained problem solved with every vehicle mode at least ζ_min "
@@ -276,7 +287,8 @@ def _surface(result: CampaignResult, s: ModelSections, g: TradeoffSurfaces, writ
     for bd in g.boundaries:
         writer.table(_csv(result, g.constrained.to_pandas().assign(**{bd.label.split(" ")[0]: bd.values.ravel()}),
                           s.model), f"{stem}_{bd.label.split(' ')[0].replace(' ', '_')}")
-    writer.figure(plot_surfaces(g.constrained, g.unconstrained, f"{s.model}: U over {a} × {b}",
+    title = figure_title(result.config, s.model, f"U over {a} × {b}")
+    writer.figure(plot_surfaces(g.constrained, g.unconstrained, title,
                                 boundaries=g.boundaries, marks=g.marks, units=g.units), stem,
                   dpi=result.config.report.dpi)
     cmin, umin = g.constrained.minimum(), g.unconstrained.minimum(inside_only=False)

@@ -5,6 +5,7 @@ surfaces) in the measure its objective minimised, and the vehicle each model is 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -40,9 +41,10 @@ from railopt.studies.kinds.campaign.tradeoffs import (
     surfaces,
     tradeoff_table,
 )
+from railopt.studies.output.figures import vehicle_label
 from railopt.studies.output.records import FrfPanel
 
-__all__ = ["BeforeAfter", "ModelSections", "model_vehicles", "outcome_counts", "start_outcomes"]
+__all__ = ["BeforeAfter", "ModelSections", "figure_title", "model_vehicles", "outcome_counts", "start_outcomes"]
 
 
 @dataclass(frozen=True)
@@ -78,21 +80,41 @@ class ModelSections:
 def model_vehicles(cfg: CampaignStudyConfig) -> dict[str, dict[str, str]]:
     """The vehicle of each ``[[models]]`` entry built from a vehicle file, by label: ``{"vehicle": its name (the
     file's ``[vehicle] name``), "vehicle_file": the file}`` — a bundled one as ``"<name>.toml (bundled)"``, another
-    by its path relative to the working directory when under it.  Models without a vehicle (``tmd``) are absent."""
-    bundled = bundled_vehicles()
-    out = {}
+    by its path relative to the working directory when under it.  Models without a vehicle (``tmd``) are absent.
+    Each file is read once per (label, source, working directory), however many tables name it."""
+    sources = []
     for i, ref in enumerate(cfg.models):
         source = getattr(ref.validated_options(f"models[{i}]"), "vehicle", None)
-        if not isinstance(source, str):
-            continue
+        if isinstance(source, str):  # the file's modification time in the key: an edited file is read again
+            stamp = Path(source).stat().st_mtime_ns if Path(source).is_file() else 0
+            sources.append((ref.label, source, stamp))
+    return {label: dict(v) for label, v in _vehicles(tuple(sources), str(Path.cwd()))}
+
+
+@lru_cache(maxsize=64)
+def _vehicles(sources: tuple[tuple[str, str, int], ...], cwd: str) -> tuple:
+    bundled = bundled_vehicles()
+    out = []
+    for label, source, _ in sources:
         vehicle = load_vehicle(source)
         if source in bundled:
             shown = f"{source}.toml (bundled)"
         else:
             path = Path(vehicle.path).resolve()
-            shown = str(path.relative_to(Path.cwd())) if path.is_relative_to(Path.cwd()) else str(path)
-        out[ref.label] = {"vehicle": vehicle.name, "vehicle_file": shown}
-    return out
+            shown = str(path.relative_to(cwd)) if path.is_relative_to(cwd) else str(path)
+        out.append((label, (("vehicle", vehicle.name), ("vehicle_file", shown))))
+    return tuple(out)
+
+
+def figure_title(cfg: CampaignStudyConfig, model: str, text: str) -> str:
+    """A figure title naming the model's vehicle and file: ``"sd40-2 (sd40-2.toml): <text>"``, or for a model
+    labelled other than its vehicle ``"coach_a: manchester-coach (coach.toml): <text>"``; ``"<model>: <text>"``
+    for a model without a vehicle."""
+    v = model_vehicles(cfg).get(model)
+    if v is None:
+        return f"{model}: {text}"
+    label = vehicle_label(v["vehicle"], v["vehicle_file"].removesuffix(" (bundled)"))
+    return f"{label}: {text}" if model == v["vehicle"] else f"{model}: {label}: {text}"
 
 
 # ---------------------------------------------------------------------------------------------- start outcomes
@@ -233,7 +255,10 @@ def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], compari
             curves.append((f"{label} ({rms}peak {r['true_peak']:.6g})", f_hz,
                            np.abs(setup.family.at(p).frf(frequencies_hz=f_hz, output=target.output)),
                            r["objective"]))
-        panels.append(FrfPanel.build(f"{model}: {setup.description}", setup.axis_label(target.output), curves))
+        v = model_vehicles(cfg).get(model)
+        title = (f"{setup.description} ({Path(v['vehicle_file'].removesuffix(' (bundled)')).name})" if v
+                 else f"{model}: {setup.description}")
+        panels.append(FrfPanel.build(title, setup.axis_label(target.output), curves))
     return panels
 
 
@@ -300,7 +325,8 @@ def _before_after(cfg: CampaignStudyConfig, setup: ModelSetup, after: dict[str, 
     loci = None
     if cfg.report.locus_speeds_m_s is not None:
         speeds = np.linspace(*cfg.report.locus_speeds_m_s, 80)
-        loci = {label: root_locus(setup.stability_model(p), speeds).to_pandas()
+        loci = {label: pd.concat([root_locus(setup.stability_model(p, track), speeds).to_pandas().assign(track=track)
+                                  for track in setup.stability], ignore_index=True)
                 for label, p in (("before", p_before), ("after", p_after))}
     thesis = sys_a.response_maxima(band_rad_s=band, exact=False, output=objective_output).value
     return BeforeAfter(pd.DataFrame(rows), thesis,
