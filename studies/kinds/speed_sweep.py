@@ -27,7 +27,7 @@ from railopt.studies.config import FiniteModel, Interval, not_one_of
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_root_locus, vehicle_label
 from railopt.studies.output.map_figure import plot_stability_map
-from railopt.studies.output.markdown import markdown_table
+from railopt.studies.output.markdown import markdown_table, stable_over
 from railopt.studies.output.mode_figure import plot_mode_shapes
 from railopt.studies.output.writer import Writer
 
@@ -278,18 +278,22 @@ def report(result: SpeedSweepResult, writer: Writer) -> str:
         name = writer.figure(plot_mode_shapes(shape.view, shape.system, shape.title), f"modes_{_slug(shape.label)}",
                              dpi=cfg.dpi)
         shapes.append(f"![modes of {shape.label} at {shape.speed:.4g} m/s]({name})")
+    stable = dict.fromkeys(("critical_speed_m_s", "critical_speed_mph"), stable_over(cfg.critical.range_m_s))
     lines = [f"# {cfg.study.name}", "", cfg.study.description, "",
              f"Root locus over {cfg.speeds.range_m_s[0]:g}–{cfg.speeds.range_m_s[1]:g} m/s; critical speed searched "
              f"in {cfg.critical.range_m_s[0]:g}–{cfg.critical.range_m_s[1]:g} m/s to ±{cfg.critical.tol_m_s:g} m/s.",
-             "", markdown_table(critical_table), ""]
+             "", markdown_table(critical_table, infinite=stable), ""]
     if len(track_effect):
-        lines += ["Flexible against rigid track (same vehicle and parameters):", "", markdown_table(track_effect), ""]
-        lines += _track_effect_sentences(track_effect, sens_table)
+        lines += ["Flexible against rigid track (same vehicle and parameters):", "",
+                  markdown_table(track_effect, infinite=dict.fromkeys(("rigid_m_s", "flexible_m_s"), stable[
+                      "critical_speed_m_s"])), ""]
+        lines += _track_effect_sentences(track_effect, sens_table, stable["critical_speed_m_s"])
         writer.table(track_effect, "track_effect")
     if len(sens_table):
         pivot = sensitivity_pivot(sens_table)
         lines += ["Critical speed (m/s) with one parameter scaled by `factor` (all columns in `sensitivity.csv`):",
-                  "", markdown_table(pivot, digits=5), ""]
+                  "", markdown_table(pivot, digits=5, infinite=dict.fromkeys(
+                      map(str, pivot.columns), stable_over(cfg.critical.range_m_s))), ""]
     if len(result.maps):
         verdict = ("certified for every model" if bool(critical_table["certified"].all())
                    else "NOT certified for every model (see the method column)")
@@ -321,16 +325,25 @@ def _slug(label: str) -> str:
     return "".join(c if c.isalnum() or c in "-_" else "_" for c in label)
 
 
-def _track_effect_sentences(effect: pd.DataFrame, sens: pd.DataFrame) -> list[str]:
-    """The rigid/flexible finding in words, with the track-modulus limit when it was swept."""
+def _track_effect_sentences(effect: pd.DataFrame, sens: pd.DataFrame,
+                            stable: str = "stable over the range") -> list[str]:
+    """The rigid/flexible finding in words, with the track-modulus limit when it was swept; a track on which the
+    search found no crossing is named ``stable`` (:func:`stable_over`), never a change of ``nan`` %."""
     lines = []
     for _, r in effect.iterrows():
+        if not (np.isfinite(r["rigid_m_s"]) and np.isfinite(r["flexible_m_s"])):
+            words = {True: stable}
+            rigid = words.get(bool(np.isinf(r["rigid_m_s"])), f"{r['rigid_m_s']:.4g} m/s")
+            flexible = words.get(bool(np.isinf(r["flexible_m_s"])), f"{r['flexible_m_s']:.4g} m/s")
+            lines.append(f"- `{r['flexible']}`: critical speed on flexible track {flexible}, on rigid track "
+                         f"(`{r['rigid']}`) {rigid}: no change can be given.")
+            continue
         verb = "raises" if r["change_m_s"] > 0 else "lowers"
         text = (f"- `{r['flexible']}`: the flexible track {verb} the critical speed by "
                 f"{abs(r['change_percent']):.2f} % ({abs(r['change_m_s']):.3f} m/s) against `{r['rigid']}`.")
         if len(sens) and "track_modulus" in set(sens["parameter"]):
             rows = sens[(sens["parameter"] == "track_modulus") & (sens["model"] == r["flexible"])]
-            steps = ", ".join(f"×{f:g}: {100 * (v / r['rigid_m_s'] - 1):+.2f} %"
+            steps = ", ".join(f"×{f:g}: {stable}" if np.isinf(v) else f"×{f:g}: {100 * (v / r['rigid_m_s'] - 1):+.2f} %"
                               for f, v in zip(rows["factor"], rows["critical_speed_m_s"], strict=True))
             text += f" Against the rigid value with the track modulus scaled: {steps} (→ rigid as the modulus grows)."
         lines.append(text)
@@ -350,10 +363,11 @@ def _track_effect(cfg: SpeedSweepConfig, critical: pd.DataFrame) -> pd.DataFrame
     for pair in by_key.values():
         if {"rigid", "flexible"} <= set(pair):
             r, f = crit.loc[pair["rigid"]], crit.loc[pair["flexible"]]
+            both = np.isfinite(r["critical_speed_m_s"]) and np.isfinite(f["critical_speed_m_s"])
+            change = f["critical_speed_m_s"] - r["critical_speed_m_s"] if both else np.nan  # no change to a range
             rows.append({"rigid": pair["rigid"], "flexible": pair["flexible"],
                          "rigid_m_s": r["critical_speed_m_s"], "flexible_m_s": f["critical_speed_m_s"],
-                         "change_m_s": f["critical_speed_m_s"] - r["critical_speed_m_s"],
-                         "change_percent": 100 * (f["critical_speed_m_s"] / r["critical_speed_m_s"] - 1),
+                         "change_m_s": change, "change_percent": 100 * change / r["critical_speed_m_s"],
                          "rigid_hz": r["hunting_frequency_hz"], "flexible_hz": f["hunting_frequency_hz"]})
     return pd.DataFrame(rows)
 
