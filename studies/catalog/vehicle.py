@@ -10,6 +10,8 @@ speed) and ``hunting`` (:class:`HuntingCheck`).  ``vehicle`` is required: no mod
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
+from pathlib import Path
 from typing import Literal
 
 from pydantic import Field
@@ -17,6 +19,7 @@ from pydantic import Field
 from railopt.models import ParametricSystem
 from railopt.models.vehicle import load_vehicle
 from railopt.models.vehicle.assembly import TRACKS
+from railopt.models.vehicle.loader import bundled_vehicles
 from railopt.models.vehicle.outputs import UNIT_SUFFIX, output_rows
 from railopt.studies.catalog import (
     AbscissaCheck,
@@ -31,8 +34,8 @@ from railopt.studies.config import StrictModel, not_one_of
 
 __all__ = [
     "VEHICLE", "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family",
-    "load", "physical_limits", "readable_aliases", "tracks_of", "vehicle_forced_model", "vehicle_forced_setup",
-    "vehicle_lateral_setup", "vehicle_setup", "vehicle_warnings",
+    "load", "model_vehicles", "physical_limits", "readable_aliases", "tracks_of", "vehicle_forced_model",
+    "vehicle_forced_setup", "vehicle_lateral_setup", "vehicle_setup", "vehicle_title", "vehicle_warnings",
 ]
 
 VEHICLE = ("a bundled vehicle name (sd40-2, manchester-coach, single-wheelset) or a vehicle file path (relative "
@@ -52,6 +55,47 @@ def load(options):
             unknown = not_one_of(name, vehicle.parameter_names(), "parameter")
             raise ValueError(f"parameters.{name}: {unknown} (vehicle {vehicle.name!r})") from None
     return vehicle.with_parameters(options.parameters) if options.parameters else vehicle
+
+
+def model_vehicles(models: Sequence) -> dict[str, dict[str, str]]:
+    """The vehicle of each ``[[models]]`` entry built from a vehicle file, by label: ``{"vehicle": its name (the
+    file's ``[vehicle] name``), "vehicle_file": the file}`` — a bundled one as ``"<name>.toml (bundled)"``, another
+    by its path relative to the working directory when under it.  Models without a vehicle (``tmd``) are absent.
+    Each file is read once per (label, source, modification time, working directory), however many tables name it.
+    """
+    sources = []
+    for i, ref in enumerate(models):
+        source = getattr(ref.validated_options(f"models[{i}]"), "vehicle", None)
+        if isinstance(source, str):  # the file's modification time in the key: an edited file is read again
+            stamp = Path(source).stat().st_mtime_ns if Path(source).is_file() else 0
+            sources.append((ref.label, source, stamp))
+    return {label: dict(v) for label, v in _vehicles(tuple(sources), str(Path.cwd()))}
+
+
+@lru_cache(maxsize=64)
+def _vehicles(sources: tuple[tuple[str, str, int], ...], cwd: str) -> tuple:
+    bundled = bundled_vehicles()
+    out = []
+    for label, source, _ in sources:
+        vehicle = load_vehicle(source)
+        if source in bundled:
+            shown = f"{source}.toml (bundled)"
+        else:
+            path = Path(vehicle.path).resolve()
+            shown = str(path.relative_to(cwd)) if path.is_relative_to(cwd) else str(path)
+        out.append((label, (("vehicle", vehicle.name), ("vehicle_file", shown))))
+    return tuple(out)
+
+
+def vehicle_title(models: Sequence, model: str, text: str) -> str:
+    """A figure title naming the model's vehicle and file: ``"sd40-2 (sd40-2.toml): <text>"``, or for a model
+    labelled other than its vehicle ``"coach_a: manchester-coach (coach.toml): <text>"``; ``"<model>: <text>"``
+    for a model without a vehicle."""
+    v = model_vehicles(models).get(model)
+    if v is None:
+        return f"{model}: {text}"
+    label = f"{v['vehicle']} ({Path(v['vehicle_file'].removesuffix(' (bundled)')).name})"
+    return f"{label}: {text}" if model == v["vehicle"] else f"{model}: {label}: {text}"
 
 
 def vehicle_warnings(config: object) -> list[str]:

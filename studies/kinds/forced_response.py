@@ -30,7 +30,7 @@ from railopt.models.stability import modes, spectral_abscissa
 from railopt.models.units import FOOT, INCH, MPH
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.catalog import ModelsStudy, require_unique
-from railopt.studies.catalog.vehicle import VehicleForcedOptions, vehicle_forced_model
+from railopt.studies.catalog.vehicle import VehicleForcedOptions, model_vehicles, vehicle_forced_model, vehicle_title
 from railopt.studies.config import BandHz, FileName, FiniteModel
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_forced_response
@@ -292,7 +292,8 @@ def compute(config: ForcedResponseConfig, context: StudyContext) -> ForcedResult
             _track_responses(cfg, g, track, entry, out)
         c, f = _curves_and_figures(g, models, out)
         curves += c
-        figures += f
+        figures += [replace(x, title=vehicle_title(cfg.models, g.rigid, x.title).removeprefix(f"{g.rigid}: "))
+                    for x in f]  # the vehicle and its file named, not the model label
         groups.append(out)
     return ForcedResult(cfg, pd.concat(curves, ignore_index=True),
                         _ratios(pd.DataFrame([r for o in groups for r in o.peaks])),
@@ -404,8 +405,11 @@ def _findings(table: pd.DataFrame) -> list[str]:
 def _models_section(r: ForcedResult) -> list[str]:
     cfg = r.config
     lines = [f"# {cfg.study.name}", "", cfg.study.description, "", "## Models", ""]
+    vehicles = model_vehicles(cfg.models)
     for label, o in ((m.label, m.validated_options("models")) for m in cfg.models):
-        lines.append(f"* `{label}`: {o.vehicle}, {o.view} block, {o.track} track, S = {o.speed_m_s:g} m/s "
+        v = vehicles.get(label, {"vehicle": o.vehicle, "vehicle_file": ""})
+        lines.append(f"* `{label}`: **{v['vehicle']}** (file `{v['vehicle_file']}`), {o.view} block, {o.track} track, "
+                     f"S = {o.speed_m_s:g} m/s "
                      f"({o.speed_m_s / MPH:.1f} mph), {o.input.kind} irregularity, amplitude "
                      f"{o.input.amplitude_m:g} m per rail ({o.input.amplitude_m / INCH:.3g} in)")
     for g in cfg.groups:

@@ -18,6 +18,7 @@ from pydantic import Field, model_validator
 from railopt.models import all_response_maxima
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
+from railopt.studies.catalog.vehicle import model_vehicles, vehicle_title
 from railopt.studies.config import BandHz, FileName, FiniteModel, not_one_of
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_frf_panels
@@ -119,6 +120,7 @@ def _model_curves(cfg: FRFStudyConfig, i: int, ref, f_hz: np.ndarray, band: tupl
     setup = ref.setup(f"models[{i}]")
     outputs = cfg.outputs or list(setup.family.output_names)
     curves, peaks = [], []
+    vehicle = model_vehicles(cfg.models).get(ref.label, {})  # vehicle and vehicle_file (none for a tmd model)
     panel_curves: dict[str, list] = {o: [] for o in outputs}
     for j, d in enumerate(cfg.designs):
         values = d.resolve(setup, f"designs[{j}]")
@@ -131,12 +133,12 @@ def _model_curves(cfg: FRFStudyConfig, i: int, ref, f_hz: np.ndarray, band: tupl
             curves.append(pd.DataFrame({"model": ref.label, "design": d.label, "output": o, "frequency_hz": f_hz,
                                         "amplitude": np.abs(h), "phase_deg": np.degrees(np.angle(h))}))
             rm = maxima[o]
-            peaks.append({"model": ref.label, "design": d.label, "output": o, "peak": rm.value,
+            peaks.append({"model": ref.label, **vehicle, "design": d.label, "output": o, "peak": rm.value,
                           "frequency_hz": rm.argmax_frequency / HZ, "certified": rm.certified,
                           "grid_points": rm.grid_points, "evaluation": rm.evaluation})
             panel_curves[o].append((f"{d.label} (peak {rm.value:.6g} at {rm.argmax_frequency / HZ:.4g} Hz)",
                                     f_hz, np.abs(h), f"C{j}"))
-    panels = [FrfPanel.build(f"{ref.label}: {setup.description}", setup.axis_label(o), c)
+    panels = [FrfPanel.build(vehicle_title(cfg.models, ref.label, setup.description), setup.axis_label(o), c)
               for o, c in panel_curves.items()]
     return curves, peaks, panels
 

@@ -37,6 +37,7 @@ from railopt.models.random_response import _check_spectrum_band, output_psd, ran
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.studies.adapter import ResponseTarget, RMSTarget, minimax_problem
 from railopt.studies.catalog import ModelSetup, ModelsStudy, require_unique
+from railopt.studies.catalog.vehicle import model_vehicles, vehicle_title
 from railopt.studies.config import BandHz, FileName, FiniteModel
 from railopt.studies.kind import StudyContext, StudyKind, register_kind
 from railopt.studies.output.figures import plot_frf_panels
@@ -215,12 +216,14 @@ def compute(config: RideStudyConfig, context: StudyContext) -> RideResult:
                                                                                     criterion=label))
             designs[label] = _optimum(table, names)
         a = setup.input_amplitude_m
+        vehicles = model_vehicles(cfg.models)
         frf_curves, psd_curves = [], []
         f_frf = np.geomspace(case.band_hz[0], case.band_hz[1], cfg.psd_points)
         for label, (values, converged) in designs.items():
             ev = evaluate_design(case, setup, values, cfg.psd_points)
             p, _ = setup.parameters(names, np.array([values[n] for n in names]))
-            rows.append({"case": case.label, "model": case.model, "output": case.output, "direction": case.direction,
+            rows.append({"case": case.label, "model": case.model, **vehicles.get(case.model, {}),
+                         "output": case.output, "direction": case.direction,
                          "design": label, **values, **{k: v for k, v in ev["ids"].items() if k not in values},
                          "converged": converged, "active_bounds": _active_bounds(case, values),
                          **{k: ev[k] for k in ("peak_sinusoid", "peak_per_m", "rms", "n_mv", "comfort_class", "wz",
@@ -234,7 +237,7 @@ def compute(config: RideStudyConfig, context: StudyContext) -> RideResult:
             psd_curves.append((f"{label} (RMS {ev['rms']:.4g} m/s², N_MV {ev['n_mv']:.3g})", ev["frequencies_hz"],
                                ev["psd"], key))
         unit = setup.units.get(case.output, "m/s²")
-        title = f"{case.label}: {setup.description.rsplit(',', 1)[0]}"
+        title = vehicle_title(cfg.models, case.model, f"{case.label}, {setup.description.rsplit(',', 1)[0]}")
         frf_panels.append(FrfPanel.build(title, f"|{case.output}| ({unit} per m of irregularity)", frf_curves))
         psd_panels.append(FrfPanel.build(f"{title}; {case.spectrum.spectrum().label}",
                                          f"PSD of {case.output} ((m/s²)²/Hz)", psd_curves))
@@ -274,12 +277,16 @@ def report(result: RideResult, writer: Writer) -> str:
         before, after = rows.loc["existing"], rows.loc["rms_random"]
         lines += [f"## {case.label}", "",
                   f"{case.output} ({case.direction}) of {case.model} at {before['speed_m_s']:g} m/s, "
-                  f"{before['band_lo_hz']:g}–{before['band_hi_hz']:g} Hz, {before['spectrum']}.", "",
+                  f"{before['band_lo_hz']:g}–{before['band_hi_hz']:g} Hz, {before['spectrum']}."
+                  + (f" Vehicle: **{before['vehicle']}**, file `{before['vehicle_file']}`."
+                     if "vehicle" in rows else ""),
+                  "",
                   f"**Comfort before → after (the RMS-random optimum):** RMS {before['rms']:.4g} → {after['rms']:.4g} "
                   f"m/s²; N_MV ({case.direction} only) {before['n_mv']:.3g} ({before['comfort_class']}) → "
                   f"{after['n_mv']:.3g} ({after['comfort_class']}); Sperling Wz {before['wz']:.3g} → "
                   f"{after['wz']:.3g}.", ""]
-        cols = ["design", *[v.name for v in case.variables], "peak_sinusoid", "peak_vs_sinusoid_optimum", "rms",
+        cols = ["design", *[c for c in ("vehicle",) if c in rows], *[v.name for v in case.variables],
+                "peak_sinusoid", "peak_vs_sinusoid_optimum", "rms",
                 "rms_vs_rms_optimum", "n_mv", "comfort_class", "wz", "stable", "active_bounds"]
         lines += [markdown_table(rows.reset_index()[cols]), ""]
     lines += ["`peak_sinusoid`: certified band maximum under the model's sinusoid (amplitude `amplitude_m`); `rms`: "

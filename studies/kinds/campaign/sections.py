@@ -5,7 +5,6 @@ surfaces) in the measure its objective minimised, and the vehicle each model is 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -15,10 +14,10 @@ from railopt.design.result import FEASIBILITY_TOL
 from railopt.models.stability import root_locus
 from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.models.units import m_to_in
-from railopt.models.vehicle import load_vehicle
-from railopt.models.vehicle.loader import bundled_vehicles
 from railopt.studies.adapter import objective_value, response_target, rms_target
 from railopt.studies.catalog import ModelSetup
+from railopt.studies.catalog.vehicle import model_vehicles as catalog_model_vehicles
+from railopt.studies.catalog.vehicle import vehicle_title
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
 from railopt.studies.kinds.campaign.problems import (
     MEASURES,
@@ -41,7 +40,6 @@ from railopt.studies.kinds.campaign.tradeoffs import (
     surfaces,
     tradeoff_table,
 )
-from railopt.studies.output.figures import vehicle_label
 from railopt.studies.output.records import FrfPanel
 
 __all__ = ["BeforeAfter", "ModelSections", "figure_title", "model_vehicles", "outcome_counts", "start_outcomes"]
@@ -78,43 +76,13 @@ class ModelSections:
 
 # ---------------------------------------------------------------------------------------------- vehicles
 def model_vehicles(cfg: CampaignStudyConfig) -> dict[str, dict[str, str]]:
-    """The vehicle of each ``[[models]]`` entry built from a vehicle file, by label: ``{"vehicle": its name (the
-    file's ``[vehicle] name``), "vehicle_file": the file}`` — a bundled one as ``"<name>.toml (bundled)"``, another
-    by its path relative to the working directory when under it.  Models without a vehicle (``tmd``) are absent.
-    Each file is read once per (label, source, working directory), however many tables name it."""
-    sources = []
-    for i, ref in enumerate(cfg.models):
-        source = getattr(ref.validated_options(f"models[{i}]"), "vehicle", None)
-        if isinstance(source, str):  # the file's modification time in the key: an edited file is read again
-            stamp = Path(source).stat().st_mtime_ns if Path(source).is_file() else 0
-            sources.append((ref.label, source, stamp))
-    return {label: dict(v) for label, v in _vehicles(tuple(sources), str(Path.cwd()))}
-
-
-@lru_cache(maxsize=64)
-def _vehicles(sources: tuple[tuple[str, str, int], ...], cwd: str) -> tuple:
-    bundled = bundled_vehicles()
-    out = []
-    for label, source, _ in sources:
-        vehicle = load_vehicle(source)
-        if source in bundled:
-            shown = f"{source}.toml (bundled)"
-        else:
-            path = Path(vehicle.path).resolve()
-            shown = str(path.relative_to(cwd)) if path.is_relative_to(cwd) else str(path)
-        out.append((label, (("vehicle", vehicle.name), ("vehicle_file", shown))))
-    return tuple(out)
+    """The vehicle of each ``[[models]]`` entry by label (:func:`railopt.studies.catalog.vehicle.model_vehicles`)."""
+    return catalog_model_vehicles(cfg.models)
 
 
 def figure_title(cfg: CampaignStudyConfig, model: str, text: str) -> str:
-    """A figure title naming the model's vehicle and file: ``"sd40-2 (sd40-2.toml): <text>"``, or for a model
-    labelled other than its vehicle ``"coach_a: manchester-coach (coach.toml): <text>"``; ``"<model>: <text>"``
-    for a model without a vehicle."""
-    v = model_vehicles(cfg).get(model)
-    if v is None:
-        return f"{model}: {text}"
-    label = vehicle_label(v["vehicle"], v["vehicle_file"].removesuffix(" (bundled)"))
-    return f"{label}: {text}" if model == v["vehicle"] else f"{model}: {label}: {text}"
+    """A figure title naming the model's vehicle and file (:func:`railopt.studies.catalog.vehicle.vehicle_title`)."""
+    return vehicle_title(cfg.models, model, text)
 
 
 # ---------------------------------------------------------------------------------------------- start outcomes
