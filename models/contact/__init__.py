@@ -41,6 +41,16 @@ Equivalent conicity (EN 15302 integral method) — :mod:`.conicity`
 * ``equivalent_conicity(y, delta_r, amplitude, r0=0.46, e0=0.75) -> float`` (tan γe); Δr = r_l − r_r,
   y positive to the left; ``kinematic_wavelength(...)`` (m), ``turning_points(y, delta_r, amplitude)``,
   ``linear_delta_r_table(conicity, y_max=0.012, n=241) -> (y, delta_r)``.
+
+Creep saturation (nonlinear creep forces) — :mod:`.saturation`, :mod:`.fastsim`; ``docs/creep_saturation.md``
+
+* ``shen_hedrick_elkins(coefficients, xi_x, xi_y, xi_sp, N, mu, spin_moment="scaled") -> SaturatedCreepForces``
+  (``.Tx``, ``.Ty`` N, ``.Mz`` N·m, ``.epsilon``, ``.ratio``; arrays broadcast); ``shen_hedrick_elkins_jacobian(...)``
+  -> ∂(Tx, Ty, Mz)/∂(ξx, ξy, ξsp), shape ``S + (3, 3)``, equal to the linear law at zero creep;
+  ``she_force_ratio(r)`` (the Vermeulen–Johnson cubic).
+* ``fastsim(xi_x, xi_y, xi_sp, a, b, N, mu, G, nu, *, flexibilities=None, n_x=64, n_y=64, bound="parabolic",
+  tractions=False) -> FastsimResult`` (``.Fx``, ``.Fy`` N, ``.Mz`` N·m; optional ``.x``, ``.y``, ``.px``, ``.py``,
+  ``.slip``, ``.slip_fraction``); ``fastsim_flexibilities(a, b, G, nu) -> (L1, L2, L3)`` (m³/N).
 """
 
 from railopt.models.contact.conicity import (
@@ -60,6 +70,7 @@ from railopt.models.contact.creep import (
     kalker_coefficients,
     vermeulen_johnson_phi_psi,
 )
+from railopt.models.contact.fastsim import FastsimResult, fastsim, fastsim_flexibilities
 from railopt.models.contact.geometry import WheelRailGeometry
 from railopt.models.contact.gravity import (
     TrackRollTerms,
@@ -72,6 +83,12 @@ from railopt.models.contact.gravity import (
     yaw_gravity_stiffness,
 )
 from railopt.models.contact.hertz import HertzEllipse, hertz_coefficients, hertz_ellipse, wheel_rail_curvatures
+from railopt.models.contact.saturation import (
+    SaturatedCreepForces,
+    she_force_ratio,
+    shen_hedrick_elkins,
+    shen_hedrick_elkins_jacobian,
+)
 
 __all__ = [
     "CARTER_CONSTANT_SI",
@@ -100,4 +117,11 @@ __all__ = [
     "vermeulen_johnson_phi_psi",
     "wheel_rail_curvatures",
     "yaw_gravity_stiffness",
+    "FastsimResult",
+    "SaturatedCreepForces",
+    "fastsim",
+    "fastsim_flexibilities",
+    "she_force_ratio",
+    "shen_hedrick_elkins",
+    "shen_hedrick_elkins_jacobian",
 ]
