@@ -155,7 +155,7 @@ def fastsim(
     ------
     ValueError
         Non-finite inputs, non-positive a, b, N, μ, G or flexibilities, ν outside [0, ½], a/b outside Kalker's
-        table, an unknown ``bound``, grids smaller than 2, neither (G, ν) nor ``flexibilities``.
+        table, an unknown ``bound``, grids smaller than 2, neither or both of (G, ν) and ``flexibilities``.
     """
     if bound not in BOUNDS:
         raise ValueError(f"bound: unknown {bound!r}; choose one of {', '.join(BOUNDS)}")
@@ -175,6 +175,8 @@ def fastsim(
         flex = np.vectorize(lambda p, q: fastsim_flexibilities(p, q, Gv, nuv), otypes=[float] * 3)(ab, bb_)
         L1, L2, L3 = (np.asarray(f, dtype=float) for f in flex)
     else:
+        if G is not None or nu is not None:
+            raise ValueError("flexibilities: give either (G, nu) or flexibilities=(L1, L2, L3), not both")
         if len(flexibilities) != 3:
             raise ValueError("flexibilities: give three values (L1, L2, L3) in m^3/N")
         L1, L2, L3 = (real_array(f"flexibilities[{i}]", v) for i, v in enumerate(flexibilities))

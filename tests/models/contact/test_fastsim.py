@@ -240,8 +240,9 @@ def test_vectorised_shapes() -> None:
     ("kwargs", "match"),
     [({"N": 0.0}, "N:"), ({"mu": 0.0}, "mu:"), ({"a": -1e-3}, "a:"), ({"xi_x": np.inf}, "xi_x:"),
      ({"G": None}, "G, nu:"), ({"bound": "flat"}, "bound:"), ({"n_x": 1}, "n_x:"), ({"n_y": 2.5}, "n_y:"),
-     ({"a": 1e-3, "b": 2e-2}, "a_over_b:"), ({"flexibilities": (1e-13, 0.0, 1e-13)}, "flexibilities:"),
-     ({"nu": 0.7}, "nu:")],
+     ({"a": 1e-3, "b": 2e-2}, "a_over_b:"),
+     ({"G": None, "nu": None, "flexibilities": (1e-13, 0.0, 1e-13)}, "flexibilities: must be > 0"),
+     ({"nu": 0.7}, "nu:"), ({"flexibilities": (1e-13, 1e-13, 1e-13)}, "not both")],
 )
 def test_bad_input_raises(kwargs: dict, match: str) -> None:
     args = {"xi_x": 1e-3, "xi_y": 0.0, "xi_sp": 0.0, "a": A, "b": B, "N": N, "mu": MU, "G": G, "nu": NU} | kwargs
