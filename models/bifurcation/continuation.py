@@ -17,7 +17,9 @@ nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Academi
 
 Stability of each point: all non-trivial Floquet multipliers (eigenvalues of DP) inside the unit circle.
 
-The continuation stops, with the reason recorded, at the edge of the speed range (the point outside is not kept),
+The continuation stops, with the reason recorded, at the edge of the speed range (the step is shortened once to
+end within EDGE_TOL·speed_scale of the edge, re-aimed while the corrector moves it off; the point outside is not
+kept),
 when the cycle's amplitude falls below the shooting ``min_amplitude`` (the branch ends at a Hopf point), when the
 step falls below ``min_step``, or after ``max_points`` points.
 """
@@ -36,6 +38,8 @@ from railopt.models.bifurcation.limit_cycle import Coordinate
 from railopt.models.bifurcation.periodic_orbit import PeriodicOrbit, ShootingOptions, orbit_amplitude
 from railopt.models.bifurcation.section import PoincareSection
 from railopt.models.bifurcation.variational import flow_to_section
+
+EDGE_TOL = 1e-4  # the last point lies within EDGE_TOL·speed_scale (m/s) of the speed range's edge
 
 
 @dataclass(frozen=True)
@@ -213,6 +217,7 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
     h = options.step
     max_turn = math.cos(math.radians(options.max_turn_deg))
     reason = f"reached max_points = {options.max_points}"
+    aimed_at_edge = False
     while len(points) < options.max_points:
         here = points[-1]
         new = branch.correct(here.u + h * here.tangent, here.tangent, here.period)
@@ -225,6 +230,11 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
             continue
         speed = new.u[-1] * options.speed_scale
         if not low <= speed <= high:
+            edge = (low if speed < low else high) / options.speed_scale
+            to_edge = (edge - here.u[-1]) / here.tangent[-1] if here.tangent[-1] != 0 else 0.0
+            if 0 < to_edge < h:  # shorten the step to end on the edge
+                h, aimed_at_edge = 0.999 * to_edge, True
+                continue
             reason = f"reached the edge of the speed range [{low:g}, {high:g}] m/s (next point at {speed:.6g} m/s)"
             break
         amplitude = orbit_amplitude(rhs, *branch.state(new.u), new.period, coordinate, settings)
@@ -237,6 +247,12 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         points.append(new)
         amplitudes.append(amplitude)
         branch_ids.append(len(folds))
+        if aimed_at_edge:
+            if min(speed - low, high - speed) <= EDGE_TOL * options.speed_scale:
+                reason = (f"reached the edge of the speed range [{low:g}, {high:g}] m/s "
+                          f"(last point at {speed:.8g} m/s)")
+                break
+            aimed_at_edge = False  # the corrector moved the point off the edge: aim again
         if new.iterations <= 3:
             h = min(h * 1.3, options.max_step)
         elif new.iterations > 5:
@@ -272,6 +288,7 @@ def _locate_fold(branch: _Branch, here: _Point, h: float, rhs: RightHandSide, co
 
 
 __all__ = [
+    "EDGE_TOL",
     "ContinuationOptions",
     "continue_periodic_orbit",
 ]

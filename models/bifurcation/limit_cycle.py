@@ -3,8 +3,11 @@
 Method.  The extrema of the sampled coordinate q(t) are located (three-point parabola through each discrete
 extremum); successive maximum/minimum pairs give half-cycle amplitudes a_k = |q_{k+1} − q_k|/2 at the mid-times
 t_k.  The growth rate σ (1/s) is the least-squares slope of ln a_k against t_k; the relative amplitude change per
-cycle is g = σ T, with T the period from the upward crossings of the mid-level (linear interpolation between
-samples).  For a linear oscillator of damping ratio ζ, g = −2πζ/√(1−ζ²) (the logarithmic decrement).
+cycle is g = σ T, with T twice the least-squares spacing of the successive extremum times (for an exponentially
+decaying or growing sinusoid the extrema are exactly equally spaced).  For a linear oscillator of damping ratio
+ζ, g = −2πζ/√(1−ζ²) (minus the logarithmic decrement).  The watched coordinate must have one maximum and one
+minimum per period (a near-sinusoidal cycle, as hunting is): a cycle with extra local extrema would be read at a
+multiple of its frequency.
 
 Classification (``CycleTolerances``):
 
@@ -72,13 +75,13 @@ class CycleVerdict:
     amplitude : float
         Half the peak-to-peak of the last full cycle (state units); the range/2 when there is no cycle.
     frequency_hz : float
-        1/T from the mid-level upward crossings (Hz); NaN with fewer than two crossings.
+        1/T from the spacing of the extrema (Hz); NaN with fewer than three extrema.
     growth_rate : float
         σ = d ln(amplitude)/dt (1/s), least squares over the half-cycle amplitudes; NaN without cycles.
     growth_per_cycle : float
         σ T, the relative amplitude change per cycle (negative: decaying).
     cycles : int
-        Full cycles (upward crossings − 1) in the window.
+        Full cycles in the window ((extrema − 1) // 2).
     reason : str
         Why this classification, with the numbers compared.
     """
@@ -112,8 +115,11 @@ def watched_values(states: np.ndarray, coordinate: Coordinate) -> np.ndarray:
 
 def _extrema(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Times and values of the alternating local extrema of the sampled q (parabolic refinement)."""
-    d = np.diff(q)
-    turns = np.nonzero(np.sign(d[1:]) * np.sign(d[:-1]) < 0)[0] + 1
+    sign = np.sign(np.diff(q))
+    for i in range(1, sign.size):  # a flat step (two equal samples) keeps the previous direction
+        if sign[i] == 0:
+            sign[i] = sign[i - 1]
+    turns = np.nonzero(sign[1:] * sign[:-1] < 0)[0] + 1
     times, values, kinds = [], [], []
     for i in turns:
         t0, t1, t2 = t[i - 1], t[i], t[i + 1]
@@ -179,12 +185,9 @@ def detect_limit_cycle(t: np.ndarray, values: np.ndarray,
     half = np.abs(np.diff(extrema)) / 2
     mid = (times[1:] + times[:-1]) / 2
     amplitude = float(np.mean(half[-2:]))
-    level = float(np.mean(extrema[-2:]))
-    above = q >= level
-    up = np.nonzero(~above[:-1] & above[1:])[0]
-    crossings = t[up] + (level - q[up]) * (t[up + 1] - t[up]) / (q[up + 1] - q[up])
-    cycles = max(crossings.size - 1, 0)
-    frequency = (crossings.size - 1) / (crossings[-1] - crossings[0]) if crossings.size >= 2 else nan
+    cycles = (extrema.size - 1) // 2
+    # successive extrema are half a period apart (also for an exponentially decaying or growing sinusoid)
+    frequency = 1.0 / (2.0 * float(np.polyfit(np.arange(extrema.size), times, 1)[0]))
     positive = half > 0
     if positive.sum() >= 2:
         sigma = float(np.polyfit(mid[positive], np.log(half[positive]), 1)[0])
