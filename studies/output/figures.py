@@ -536,7 +536,7 @@ def plot_tradeoff(table: pd.DataFrame, quantity: str, title: str, required: floa
 
 
 BOUNDARY_STYLES = (("k", "--"), ("C1", ":"), ("C2", "-."), ("C4", "--"))
-MARK_STYLES = (("r", "*", 13), ("w", "X", 9), ("C1", "P", 9))
+MARK_STYLES = (("r", "*", 15), ("w", "X", 9), ("C1", "P", 9))
 
 
 def plot_surfaces(constrained: Surface, unconstrained: Surface, title: str, boundaries: Sequence[Boundary] = (),
@@ -581,10 +581,10 @@ def plot_surfaces(constrained: Surface, unconstrained: Surface, title: str, boun
                     bad = values < b.limit if b.at_least else values > b.limit
                     ax2.contourf(XI, XJ, bad.astype(float), levels=[0.5, 1.5], colors="none", hatches=["//"])
                 ax2.plot([], [], color=color, ls=ls, label=f"{b.label} ({b.limit:.4g}); hatched: violated")
-        for k, (name, values) in enumerate((marks or {}).items()):
+        for k, (name, values) in enumerate((marks or {}).items()):  # the first mark (the recommended design) on top
             color, marker, ms = MARK_STYLES[k % len(MARK_STYLES)]
             ax2.plot(np.log10(values[surf.names[0]]), np.log10(values[surf.names[1]]), marker=marker, color=color,
-                     ms=ms, ls="none", markeredgecolor="k", label=name, zorder=10, clip_on=False)
+                     ms=ms, ls="none", markeredgecolor="k", label=name, zorder=20 - k, clip_on=False)
         ax2.set_xlabel(log_label(surf.names[0], units[0]))
         ax2.set_ylabel(log_label(surf.names[1], units[1]))
         ax2.set_title(label, fontsize=9)

@@ -342,6 +342,8 @@ def test_surface_marks_sit_above_the_contours_and_the_legends_off_them():
         mark = next(line for line in ax.get_lines() if line.get_label() == "recommended")
         assert (mark.get_xdata()[0], mark.get_ydata()[0]) == (6.0, 7.0)
         assert mark.get_zorder() >= 10 and not mark.get_clip_on()
+        others = [line for line in ax.get_lines() if line.get_label() == "unconstrained optimum"]
+        assert all(mark.get_zorder() > o.get_zorder() for o in others)  # never hidden under another mark
         no_overlap(fig, ax)
 
 
