@@ -18,8 +18,8 @@ nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Academi
 Stability of each point: all non-trivial Floquet multipliers (eigenvalues of DP) inside the unit circle.
 
 The continuation stops, with the reason recorded, at the edge of the speed range (the step is shortened once to
-end within EDGE_TOL·speed_scale of the edge, re-aimed while the corrector moves it off; the point outside is not
-kept),
+end within EDGE_TOL·speed_scale of the edge, halved while the corrector overshoots it and re-aimed while the
+corrector moves it off; no point outside the range is kept),
 when the cycle's amplitude falls below the shooting ``min_amplitude`` (the branch ends at a Hopf point), when the
 step falls below ``min_step``, or after ``max_points`` points.
 """
@@ -232,8 +232,9 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         if not low <= speed <= high:
             edge = (low if speed < low else high) / options.speed_scale
             to_edge = (edge - here.u[-1]) / here.tangent[-1] if here.tangent[-1] != 0 else 0.0
-            if 0 < to_edge < h:  # shorten the step to end on the edge
-                h, aimed_at_edge = 0.999 * to_edge, True
+            shorter = min(0.999 * to_edge, 0.5 * h)  # aim at the edge; halve while the corrector overshoots it
+            if shorter >= options.min_step:
+                h, aimed_at_edge = shorter, True
                 continue
             reason = f"reached the edge of the speed range [{low:g}, {high:g}] m/s (next point at {speed:.6g} m/s)"
             break
@@ -243,7 +244,12 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
                       f"V = {speed:.6g} m/s (the branch ends at a Hopf point)")
             break
         if np.sign(new.tangent[-1]) != np.sign(here.tangent[-1]) and here.tangent[-1] != 0:
-            folds.append(_locate_fold(branch, here, h, rhs, coordinate, settings))
+            try:
+                folds.append(_locate_fold(branch, here, h, rhs, coordinate, settings))
+            except ValueError as error:
+                reason = (f"a fold between {here.u[-1] * options.speed_scale:.6g} and {speed:.6g} m/s could not "
+                          f"be located: {error}")
+                break
         points.append(new)
         amplitudes.append(amplitude)
         branch_ids.append(len(folds))
@@ -280,6 +286,8 @@ def _locate_fold(branch: _Branch, here: _Point, h: float, rhs: RightHandSide, co
         cache[s] = point
         return float(point.tangent[-1])
 
+    if speed_component(0.0) * speed_component(h) > 0:
+        raise ValueError("fold: the tangent's speed component has the same sign at both ends of the step")
     s_fold = brentq(speed_component, 0.0, h, xtol=1e-12 * h, rtol=4 * np.finfo(float).eps)
     point = cache.get(s_fold) or branch.correct(here.u + s_fold * here.tangent, here.tangent, here.period)
     x, speed = branch.state(point.u)

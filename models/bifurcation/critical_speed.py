@@ -5,8 +5,9 @@
 2. From the state at the end of the dwell at V_high the trajectory is run to the Poincaré section and
    :func:`.periodic_orbit.find_periodic_orbit` converges the stable cycle there (period guess 1/frequency from
    the detector).
-3. :func:`.continuation.continue_periodic_orbit` follows it towards lower speeds, through the fold, onto the
-   unstable branch, until a stopping rule fires.
+3. :func:`.continuation.continue_periodic_orbit` follows it up to the top of the speed range and down,
+   through the fold, onto the unstable branch, until a stopping rule fires; the two runs are joined in order
+   of arclength (highest speed of the stable branch first).
 
 The diagram returned carries the ramp; ``diagram.nonlinear_critical_speed()`` gives the fold speed confirmed
 by the ramp's bracket.
@@ -93,10 +94,27 @@ def bifurcation_diagram(rhs: RightHandSide, x0: np.ndarray, speeds: np.ndarray, 
         return _empty(n, f"no periodic orbit at the last steady ramp speed {speed:g} m/s: {orbit.reason}", ramp,
                       linear_critical_speed)
     low, high = speed_range if speed_range is not None else (float(np.min(speeds)), float(np.max(speeds)))
-    diagram = continue_periodic_orbit(rhs, orbit, section, coordinate, speed_range=(low, high), direction=-1,
-                                      options=continuation, shooting=shooting, settings=settings,
-                                      jacobian=jacobian, linear_critical_speed=linear_critical_speed)
-    return dataclasses.replace(diagram, ramp=ramp)
+    up, down = (continue_periodic_orbit(rhs, orbit, section, coordinate, speed_range=(low, high),
+                                        direction=direction, options=continuation, shooting=shooting,
+                                        settings=settings, jacobian=jacobian,
+                                        linear_critical_speed=linear_critical_speed) for direction in (1, -1))
+    return dataclasses.replace(_joined(up, down), ramp=ramp)
+
+
+def _joined(up: BifurcationDiagram, down: BifurcationDiagram) -> BifurcationDiagram:
+    """One diagram from the two continuations out of the same start: ``up`` reversed, then ``down``."""
+    passed = len(up.folds)
+
+    def join(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.concatenate([a[:0:-1], b])
+
+    return BifurcationDiagram(
+        speed=join(up.speed, down.speed), amplitude=join(up.amplitude, down.amplitude),
+        period=join(up.period, down.period), multipliers=join(up.multipliers, down.multipliers),
+        stable=join(up.stable, down.stable), branch=join(passed - up.branch, down.branch + passed),
+        points=join(up.points, down.points), folds=(*up.folds[::-1], *down.folds),
+        stop_reason=f"upwards: {up.stop_reason}; downwards: {down.stop_reason}",
+        linear_critical_speed=down.linear_critical_speed)
 
 
 __all__ = [

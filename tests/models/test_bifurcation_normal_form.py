@@ -129,7 +129,13 @@ def test_ramp_brackets_the_fold_and_agrees_with_continuation_within_its_step():
     # above the fold the ramp sat on the stable cycle: the detector's amplitude is the closed-form radius
     k = ramp.last_steady
     assert ramp.verdicts[k].amplitude == pytest.approx(radius(ramp.speeds[k], +1), rel=1e-4)
-    assert diagram.to_pandas().attrs["linear_critical_speed_m_s"] == V_C
+    table = diagram.to_pandas()
+    assert table.attrs["linear_critical_speed_m_s"] == V_C
+    # continued up from the last steady ramp speed to the range's top and down through the fold to the Hopf point
+    assert table.speed_m_s.iloc[0] == pytest.approx(34.0, abs=1e-2) and np.all(table.branch.diff().iloc[1:] >= 0)
+    outer = table[table.branch == 0]
+    np.testing.assert_allclose(outer.amplitude, radius(outer.speed_m_s.to_numpy(), +1), rtol=1e-6)
+    assert outer.stable.all() and not table[table.branch == 1].stable.any()
 
 
 def _trajectory(speed: float, r0: float, t_end: float, rate: float) -> tuple[np.ndarray, np.ndarray]:
@@ -151,3 +157,15 @@ def test_detector_reads_the_stable_cycle_and_calls_the_motion_below_the_fold_dec
     verdict = detect_limit_cycle(t, x)
     assert verdict.classification == "decaying", verdict.reason
     assert verdict.frequency_hz == pytest.approx(OMEGA / (2 * math.pi), rel=1e-3)
+
+
+@pytest.mark.parametrize("method, rtol", [("LSODA", 1e-10), ("Radau", 1e-9), ("BDF", 1e-10), ("DOP853", 1e-10)])
+def test_every_integration_method_gives_the_closed_form_cycle(method, rtol):
+    """The stiff methods get the augmented Jacobian blockdiag(J, J ⊗ I); all reach the closed form."""
+    speed = 27.0
+    r = radius(speed, +1)
+    orbit = find_periodic_orbit(rhs, np.array([0.95, 0.0]), speed, SECTION, 0.8 * PERIOD, 0,
+                                settings=IntegrationSettings(method=method, rtol=rtol, atol=1e-12))
+    assert orbit.converged, orbit.reason
+    assert orbit.amplitude == pytest.approx(r, rel=1e-6)
+    assert abs(orbit.multipliers[0] - multiplier(speed, r)) < 1e-5
