@@ -51,6 +51,26 @@ Creep saturation (nonlinear creep forces) — :mod:`.saturation`, :mod:`.fastsim
 * ``fastsim(xi_x, xi_y, xi_sp, a, b, N, mu, G, nu, *, flexibilities=None, n_x=64, n_y=64, bound="parabolic",
   tractions=False) -> FastsimResult`` (``.Fx``, ``.Fy`` N, ``.Mz`` N·m; optional ``.x``, ``.y``, ``.px``, ``.py``,
   ``.slip``, ``.slip_fraction``); ``fastsim_flexibilities(a, b, G, nu) -> (L1, L2, L3)`` (m³/N).
+
+Profiles — :mod:`.profiles`; ``docs/contact_geometry.md``
+
+* ``Profile(y, z, kind, name="", flange_back=None, taping_line=0.0, source="")`` — frozen; one wheel or rail
+  section seen as the LEFT one: y (m) towards the field side, z (m) UP; ``.height/.slope/.curvature(y)``,
+  ``.rolling_radius(y, r0)``, ``.inclined(t)``; ``load_profile(name_or_path)`` (``PROFILE_NAMES``: "s1002",
+  "60e1" = "uic60", "mbench_s1002", "mbench_uic60", "r_uic519_a/b/h/i", "s_uic519_a"; or a .prw/.prr/CSV path),
+  ``read_simpack_profile(path)``, ``read_profile_csv(path, kind)`` (mm), ``s1002()``, ``rail_60e1()``,
+  ``incline(rail, 1/40, about=(0, 0))``.
+
+Rigid contact geometry tables — :mod:`.rigid_contact`; ``docs/contact_geometry.md``
+
+* ``WheelsetTrack(wheel_left, wheel_right, rail_left, rail_right, gauge=1.435, flange_back_distance=1.360,
+  r0_left=0.46, r0_right=0.46, inclination=0.0, gauge_height=0.014)``, ``WheelsetTrack.symmetric(wheel, rail,
+  r0=..., ...)``.
+* ``rigid_contact_table(track, y, roll=True, ...) -> ContactTable`` — frozen, arrays (n,): ``roll``, ``r_left``,
+  ``r_right``, ``delta_r`` (= r_l − r_r, y positive to the left: feeds ``equivalent_conicity`` directly), contact
+  angles, contact positions on wheel/rail/track, transverse curvatures, ``two_point_*``/``jump_*`` flags;
+  ``.at(y, kind="linear"|"cubic")``, ``ContactTable.conical(λ, y, r0, e0)``; ``hertz_ellipses(table, N_left,
+  N_right=None, E, nu) -> (left, right)`` lists of ``HertzEllipse``.
 """
 
 from railopt.models.contact.conicity import (
@@ -83,6 +103,17 @@ from railopt.models.contact.gravity import (
     yaw_gravity_stiffness,
 )
 from railopt.models.contact.hertz import HertzEllipse, hertz_coefficients, hertz_ellipse, wheel_rail_curvatures
+from railopt.models.contact.profiles import (
+    PROFILE_NAMES,
+    Profile,
+    incline,
+    load_profile,
+    rail_60e1,
+    read_profile_csv,
+    read_simpack_profile,
+    s1002,
+)
+from railopt.models.contact.rigid_contact import ContactTable, WheelsetTrack, hertz_ellipses, rigid_contact_table
 from railopt.models.contact.saturation import (
     SaturatedCreepForces,
     she_force_ratio,
@@ -124,4 +155,16 @@ __all__ = [
     "she_force_ratio",
     "shen_hedrick_elkins",
     "shen_hedrick_elkins_jacobian",
+    "ContactTable",
+    "PROFILE_NAMES",
+    "Profile",
+    "WheelsetTrack",
+    "hertz_ellipses",
+    "incline",
+    "load_profile",
+    "rail_60e1",
+    "read_profile_csv",
+    "read_simpack_profile",
+    "rigid_contact_table",
+    "s1002",
 ]
