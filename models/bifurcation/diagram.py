@@ -4,7 +4,7 @@ A diagram holds the points of one continued branch (:mod:`.continuation`) in ord
 amplitude, period, non-trivial Floquet multipliers and stability; ``branch`` counts the folds passed (0 before the
 first fold, 1 after it, …).  The **nonlinear critical speed** is the lowest fold speed — below it no cycle exists
 and every disturbance decays — *confirmed* when the descending speed ramp (:mod:`.ramp`) lost its steady cycle
-within the ramp step that brackets it (True & Kaas-Petersen: the lowest speed of a stable hunting cycle).
+within the ramp step that brackets it (the lowest speed at which a stable hunting cycle exists).
 """
 
 from __future__ import annotations
