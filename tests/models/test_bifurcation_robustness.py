@@ -18,6 +18,7 @@ from railopt.models.bifurcation import (
     IntegrationSettings,
     PoincareSection,
     RampResult,
+    bifurcation_diagram,
     continue_periodic_orbit,
     detect_limit_cycle,
     find_periodic_orbit,
@@ -150,3 +151,38 @@ def test_unconverged_orbit_cannot_start_a_continuation():
     failed = find_periodic_orbit(damped_oscillator(0.1), np.array([1.0, 0.0]), 10.0, SECTION, 1.0, 0)
     with pytest.raises(ValueError, match="^orbit"):
         continue_periodic_orbit(damped_oscillator(0.1), failed, SECTION, 0, speed_range=(0.0, 20.0))
+
+
+def test_watched_coordinate_may_be_a_function_of_the_state():
+    """h(x) = 2 x: the amplitude doubles (closed-form outer radius r² = (1 + √(1 + 4μ))/2 at μ = −0.1)."""
+    speed = 28.0
+    r = math.sqrt((1 + math.sqrt(1 + 4 * (speed - V_C) / V_REF)) / 2)
+    orbit = find_periodic_orbit(normal_form, np.array([1.0, 0.0]), speed, SECTION, 1.0, lambda x: 2.0 * x[0])
+    assert orbit.converged and orbit.amplitude == pytest.approx(2 * r, rel=1e-8)
+    ramp = speed_ramp(normal_form, np.array([r, 0.0]), [speed, speed - 0.5], Dwell(seconds=20.0),
+                      lambda x: 2.0 * x[0], sample_rate_hz=50.0)
+    assert ramp.verdicts[0].classification == "steady"
+    assert ramp.verdicts[0].amplitude == pytest.approx(2 * r, rel=1e-4)
+
+
+def test_a_ramp_that_never_loses_its_cycle_gives_an_empty_unconfirmed_diagram():
+    diagram = bifurcation_diagram(normal_form, np.array([1.0, 0.0]), np.arange(33.0, 27.0, -1.0),
+                                  Dwell(seconds=15.0), 0, SECTION, sample_rate_hz=40.0)
+    assert diagram.ramp.fold_bracket is None and diagram.speed.size == 0
+    assert "never lost" in diagram.stop_reason
+    critical = diagram.nonlinear_critical_speed()
+    assert not critical.confirmed and math.isnan(critical.speed)
+
+
+def test_results_are_read_only_records_with_tables():
+    start = find_periodic_orbit(normal_form, np.array([1.0, 0.0]), 33.0, SECTION, 1.0, 0)
+    with pytest.raises(ValueError):
+        start.point[0] = 0.0  # read-only
+    diagram = continue_periodic_orbit(normal_form, start, SECTION, 0, speed_range=(32.0, 34.0),
+                                      options=ContinuationOptions(speed_scale=V_REF))
+    with pytest.raises(ValueError):
+        diagram.speed[0] = 0.0
+    table = diagram.to_pandas()
+    np.testing.assert_array_equal(table.speed_m_s, diagram.speed)
+    np.testing.assert_array_equal(table.frequency_hz, 1.0 / diagram.period)
+    assert len(repr(diagram)) < 600 and diagram == diagram
