@@ -112,8 +112,13 @@ def rail_name(wheelset: str) -> str:
     return f"{wheelset}_rail"
 
 
-def assemble(vehicle: Vehicle, track: str = "rigid") -> Assembly:
-    """Assemble the vehicle on ``"rigid"`` or ``"flexible"`` (lumped, (4.33)–(4.49)) track."""
+def assemble(vehicle: Vehicle, track: str = "rigid", contact: bool = True) -> Assembly:
+    """Assemble the vehicle on ``"rigid"`` or ``"flexible"`` (lumped, (4.33)–(4.49)) track.
+
+    ``contact=False`` leaves out the linear wheel/rail terms (creep, gravity stiffness, track-roll coupling
+    of :func:`~railopt.models.vehicle.wheelrail.contact_matrices`) and keeps everything else, the contact
+    constraints included: the suspension a nonlinear contact model adds its forces to
+    (:mod:`railopt.models.vehicle.nonlinear`)."""
     if track not in TRACKS:
         raise ValueError(f"track: must be one of {TRACKS}, got {track!r}")
     wheelsets = [b for b in vehicle.bodies if b.kind == "wheelset"]
@@ -178,9 +183,10 @@ def assemble(vehicle: Vehicle, track: str = "rigid") -> Assembly:
         relations.append(Relation(coordinate(ws.name, "alpha"),
                                   ((roll, 1.0), (coordinate(ws.name, "v"), wr.psi), (coordinate(rail, "v"), -wr.psi)),
                                   f"roll constraint (4.7) {ws.name}"))
-        Kc, Cc = contact_matrices(wr, index, ws.name, roll, coordinate(rail, "v"), tb, n)
-        K0 += Kc
-        C_creep += Cc
+        if contact:
+            Kc, Cc = contact_matrices(wr, index, ws.name, roll, coordinate(rail, "v"), tb, n)
+            K0 += Kc
+            C_creep += Cc
 
     for c in vehicle.constraints:
         body = byname[c.body]
