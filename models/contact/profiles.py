@@ -50,7 +50,7 @@ KINDS = ("wheel", "rail")
 # the profile
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Profile:
     """One wheel or rail cross-section (see the module doc for the convention).
 
@@ -70,6 +70,8 @@ class Profile:
         (S1002: 0, i.e. 70 mm from the flange back).
     source : str
         Where the points come from (file, standard), for reports.
+
+    Profiles compare by identity (``is``); the arrays are read-only.
 
     Raises
     ------

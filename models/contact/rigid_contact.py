@@ -174,7 +174,7 @@ _FLOAT_FIELDS = (
 _BOOL_FIELDS = ("two_point_left", "two_point_right", "jump_left", "jump_right")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ContactTable:
     """Rigid contact geometry against the wheelset's lateral shift (arrays of shape (n,), SI units).
 
@@ -252,7 +252,8 @@ class ContactTable:
 
         ``kind="linear"``: piecewise linear between the nodes (keeps jumps sharp: use it for tables with
         flange contact); ``"cubic"``: not-a-knot cubic spline through the nodes (smooth tables only: a spline
-        rings across a jump).  Boolean flags are taken from the nearest node.
+        rings across a jump).  The boolean flags and the secondary gaps (which may be inf) are taken from the
+        nearest node.  The result is tabulated at the sorted, distinct values of ``y``.
 
         Raises
         ------
@@ -271,17 +272,18 @@ class ContactTable:
         order = np.argsort(q)
         qs = q[order]
         out: dict[str, np.ndarray] = {}
-        for name in _FLOAT_FIELDS:
-            v = getattr(self, name)
-            if kind == "linear" or not np.all(np.isfinite(v)):
-                out[name] = np.interp(qs, self.y, v)
-            else:
-                out[name] = CubicSpline(self.y, v)(qs)
         nearest = np.clip(np.searchsorted(self.y, qs), 0, self.y.size - 1)
         left = np.clip(nearest - 1, 0, self.y.size - 1)
         nearest = np.where(np.abs(self.y[left] - qs) <= np.abs(self.y[nearest] - qs), left, nearest)
-        for name in _BOOL_FIELDS:
-            out[name] = getattr(self, name)[nearest]
+        by_node = _BOOL_FIELDS + ("secondary_gap_left", "secondary_gap_right")
+        for name in _FLOAT_FIELDS + _BOOL_FIELDS:
+            v = getattr(self, name)
+            if name in by_node or not np.all(np.isfinite(v)):
+                out[name] = v[nearest]
+            elif kind == "linear":
+                out[name] = np.interp(qs, self.y, v)
+            else:
+                out[name] = CubicSpline(self.y, v)(qs)
         qs_unique, first = np.unique(qs, return_index=True)
         picked = {k: v[first] for k, v in out.items()}
         return ContactTable(y=qs_unique, r0=self.r0, e0=self.e0, **picked)
