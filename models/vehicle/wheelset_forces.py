@@ -33,8 +33,9 @@ Normal loads N_l, N_r (along n) from the quasi-static equilibrium of the wheelse
 (the axle load; dynamic vertical suspension forces are left out) and the contact forces: vertical
 ``Σ (N cos δ + Fη t_z) = W`` and roll about the wheelset centre ``Σ (p × F)_x = 0`` — two linear equations
 solved per wheelset (Cramer).  The creep forces depend on N through a saturating law, so the two are
-iterated to |ΔN| ≤ 1e-12 W (a linear law needs one pass).  Their lateral components, −σ N sin δ, are the
-gravitational stiffness: with δ from a conical geometry, ``tan δ = θ0 ± ε y/e0``, they give the W ε/e0 of
+iterated to |ΔN| ≤ 1e-10 W (a linear law needs one pass; N balances the forces of the last pass exactly).
+The normal forces' lateral components, −σ N sin δ, are the gravitational stiffness: with δ from a conical
+geometry, ``tan δ = θ0 ± ε y/e0``, they give the W ε/e0 of
 (4.43)–(4.44) and, through the yaw of the arms, the yaw gravitational stiffness −W e0 θ0 of (4.48)
 (:func:`linear_model_forces`).  The load transfer ΔN that a linear model eliminates as the reaction of its
 roll constraint (4.7) is here solved for, which gives the same linear terms (ψ = tanθ0/(e0 − r0 tanθ0) is
@@ -59,6 +60,7 @@ from dataclasses import dataclass, field
 from typing import Literal, Protocol, runtime_checkable
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
 from railopt.models.contact.saturation import SPIN_MOMENT_CHOICES, she_force_ratio
 from railopt.models.validation import number
@@ -139,15 +141,19 @@ class ConicalGeometry:
 
 @dataclass(frozen=True, eq=False)
 class TabulatedGeometry:
-    """Contact geometry interpolated (piecewise linear) in a rigid contact table over y.
+    """Contact geometry interpolated in a rigid contact table over y.
 
     Build it with :meth:`from_table` from a :class:`railopt.models.contact.rigid_contact.ContactTable` (or any
     object with its fields ``y, roll, r_left, r_right, contact_angle_left, contact_angle_right,
     track_contact_left, track_contact_right, r0``).  Arms from the table: a_l = Y_l − y, a_r = y − Y_r (Y the
     contact's lateral position in the track frame); the vertical arm is the contact's depth below the axle
     centre in the track frame, h = r cos φ − u sin φ with u the contact's lateral position in the rolled
-    wheelset frame (u = (σ a − r sin φ)/cos φ).  Piecewise-linear interpolation keeps the flange's steep rise
-    and a contact jump sharp (a spline would ring across it).
+    wheelset frame (u = (σ a − r sin φ)/cos φ).
+
+    ``kind="linear"`` interpolates piecewise linearly (keeps the flange's steep rise and a contact jump sharp,
+    but the forces then have kinks at every node, which costs an integrator steps); ``"pchip"`` uses the
+    monotone piecewise-cubic Hermite interpolant (:class:`scipy.interpolate.PchipInterpolator`: C¹, no
+    overshoot across a jump, unlike a spline).
 
     Raises
     ------
@@ -162,10 +168,19 @@ class TabulatedGeometry:
     vertical_arm: np.ndarray
     r0: float
     source: str = "contact table"
+    kind: str = "linear"
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("linear", "pchip"):
+            raise ValueError(f"kind: 'linear' or 'pchip', got {self.kind!r}")
+        stacked = np.concatenate([self.radius, self.angle, self.lateral_arm, self.vertical_arm])  # (8, n)
+        object.__setattr__(self, "_stacked", stacked)
+        if self.kind == "pchip":
+            object.__setattr__(self, "_pchip", PchipInterpolator(self.y, stacked, axis=1, extrapolate=False))
 
     @classmethod
-    def from_table(cls, table: object, source: str = "contact table") -> TabulatedGeometry:
-        """From a rigid contact table (fields named in the class docstring)."""
+    def from_table(cls, table: object, source: str = "contact table", kind: str = "linear") -> TabulatedGeometry:
+        """From a rigid contact table (fields named in the class docstring); ``kind`` of interpolation."""
         y = np.asarray(table.y, dtype=float)
         if y.ndim != 1 or y.size < 2 or not np.all(np.diff(y) > 0.0):
             raise ValueError(f"{source}: y must be a strictly increasing array of at least 2 shifts (m)")
@@ -179,21 +194,21 @@ class TabulatedGeometry:
         for name, arr in (("radius", r), ("contact angle", delta), ("lateral arm", a), ("vertical arm", h)):
             if not np.all(np.isfinite(arr)):
                 raise ValueError(f"{source}: {name} is not finite everywhere")
-        return cls(y=y, radius=r, angle=delta, lateral_arm=a, vertical_arm=h, r0=float(table.r0), source=source)
+        return cls(y=y, radius=r, angle=delta, lateral_arm=a, vertical_arm=h, r0=float(table.r0), source=source,
+                   kind=kind)
 
     def points(self, y: np.ndarray) -> ContactPoints:
         y = np.asarray(y, dtype=float)
         if y.size and (np.min(y) < self.y[0] or np.max(y) > self.y[-1]):
             raise ValueError(f"{self.source}: lateral shift {float(np.max(np.abs(y))):.6g} m outside the table "
                              f"[{self.y[0]:.6g}, {self.y[-1]:.6g}] m (beyond the flange range)")
-        # the interval of every y once, then the same weights for every field
-        i = np.clip(np.searchsorted(self.y, y, side="right") - 1, 0, self.y.size - 2)
-        w = (y - self.y[i]) / (self.y[i + 1] - self.y[i])
-
-        def at(f: np.ndarray) -> np.ndarray:
-            return f[:, i] * (1.0 - w) + f[:, i + 1] * w
-
-        return ContactPoints(at(self.radius), at(self.angle), at(self.lateral_arm), at(self.vertical_arm))
+        if self.kind == "pchip":
+            v = self._pchip(y)
+        else:  # the interval of every y once, then the same weights for every field
+            i = np.clip(np.searchsorted(self.y, y, side="right") - 1, 0, self.y.size - 2)
+            w = (y - self.y[i]) / (self.y[i + 1] - self.y[i])
+            v = self._stacked[:, i] * (1.0 - w) + self._stacked[:, i + 1] * w
+        return ContactPoints(v[0:2], v[2:4], v[4:6], v[6:8])
 
 
 # ---------------------------------------------------------------------------------------------------- creep laws
@@ -426,7 +441,7 @@ class WheelsetForces:
             if np.any(N <= 0.0):
                 raise ValueError(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0) at y = "
                                  f"{y.tolist()} m: the rigid contact no longer applies (derailment)")
-            if change <= 1e-12 * W:  # N balances these forces exactly; they are those of N within 1e-12 W
+            if change <= 1e-10 * W:  # N balances these forces exactly; they are those of N within 1e-10 W
                 break
         else:
             raise ValueError("normal load: the normal loads and creep forces did not converge in 50 passes")
@@ -471,6 +486,37 @@ def linear_model_forces(wr: WheelRail) -> WheelsetForces:
     return WheelsetForces(ConicalGeometry.from_wheel_rail(wr), creep, wr.axle_load, LinearCreepLaw(), plane="track")
 
 
+
+def profile_forces(wr: WheelRail, table: object, creep_law: CreepLaw | None = None, *, kind: str = "pchip",
+                   plane: Plane = "contact", flange: FlangeSpring | None = None) -> WheelsetForces:
+    """The forces of a vehicle's wheelset on a rigid contact table of real profiles.
+
+    Parameters
+    ----------
+    wr : WheelRail
+        The vehicle's contact (``vehicle.wheel_rail()``): creep coefficients (f23, f33 zero when ``spin`` is
+        off) and axle load.
+    table : ContactTable
+        Rigid contact geometry (e.g. ``vehicle.contact_table()`` or
+        :func:`railopt.models.contact.rigid_contact.rigid_contact_table`), with ``table.r0`` = ``wr.r0``.
+    creep_law : CreepLaw, optional
+        Default the linear law.
+    kind, plane, flange
+        As :class:`TabulatedGeometry` and :class:`WheelsetForces`.
+
+    Raises
+    ------
+    ValueError
+        The table's nominal rolling radius differs from the vehicle's (the creepages' r0 and the creep
+        coefficients would disagree).
+    """
+    if abs(float(table.r0) - wr.r0) > 1e-9:
+        raise ValueError(f"table: nominal rolling radius r0 = {float(table.r0):.6g} m differs from the vehicle's "
+                         f"[contact] wheel radius {wr.r0:.6g} m; build the table with the vehicle's r0")
+    creep = wr.creep if wr.spin else Creep(wr.creep.f11, wr.creep.f22)
+    geometry = TabulatedGeometry.from_table(table, kind=kind)
+    return WheelsetForces(geometry, creep, wr.axle_load, creep_law or LinearCreepLaw(), plane=plane, flange=flange)
+
 __all__ = [
     "FORCE_ROWS",
     "ConicalGeometry",
@@ -484,4 +530,5 @@ __all__ = [
     "WheelsetContactState",
     "WheelsetForces",
     "linear_model_forces",
+    "profile_forces",
 ]

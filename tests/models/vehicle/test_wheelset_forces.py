@@ -85,12 +85,14 @@ def s1002_uic60() -> tuple[np.ndarray, ContactTable]:
     return ys, rigid_contact_table(track, np.sort(np.concatenate([ys - d, ys, ys + d])))
 
 
-def test_normal_forces_do_no_virtual_work(s1002_uic60: tuple[np.ndarray, ContactTable]) -> None:
+@pytest.mark.parametrize("kind", ["linear", "pchip"])
+def test_normal_forces_do_no_virtual_work(s1002_uic60: tuple[np.ndarray, ContactTable], kind: str) -> None:
     """Rigid contact is workless: along the contact constraint (axle height h(y), roll φ(y)) the normal forces'
     resultant satisfies F_y + F_z h' + M_x φ' = 0; with F_z = W and M_x = 0 (the balance), F_y = −W dh/dy.
-    h' by central differences (±1e-6 m) of the table's axle height; tread and flange contact (δ up to 58°)."""
+    h' by central differences (±1e-6 m) of the table's axle height; tread and flange contact (δ up to 58°).
+    Both interpolants pass through the nodes, where this is checked."""
     ys, table = s1002_uic60
-    f = WheelsetForces(TabulatedGeometry.from_table(table), NO_CREEP, W, plane="contact")
+    f = WheelsetForces(TabulatedGeometry.from_table(table, kind=kind), NO_CREEP, W, plane="contact")
     z = np.zeros(ys.size)
     state = f.evaluate(ys, z, *rates(ys.size), speed=30.0)
     k = np.searchsorted(table.y, ys)
@@ -112,7 +114,7 @@ def test_balance_with_saturated_creep(s1002_uic60: tuple[np.ndarray, ContactTabl
     np.testing.assert_allclose(state.Q.sum(axis=0), W, rtol=1e-12)
     np.testing.assert_allclose(state.forces[2], 0.0, atol=1e-9 * W)
     resultant = np.hypot(state.Fx, state.Fy)
-    assert np.all(resultant <= 0.3 * state.N * (1 + 1e-9))  # never beyond μN (N converged to 1e-12 W)
+    assert np.all(resultant <= 0.3 * state.N * (1 + 1e-9))  # never beyond μN (N converged to 1e-10 W)
 
 
 def test_saturation_reaches_the_friction_limit() -> None:
@@ -171,3 +173,20 @@ def test_errors() -> None:
         WheelsetForces(CONE, NO_CREEP, W, plane="rail")
     with pytest.raises(ValueError, match="clearance"):
         FlangeSpring(-1e-3, 1e7)
+
+
+def test_profile_forces_checks_the_rolling_radius(s1002_uic60: tuple[np.ndarray, ContactTable]) -> None:
+    """A table and a vehicle contact with different nominal radii are refused (creepages and coefficients would
+    disagree); with the same radius the forces are those of the table (zero creep: −W dh/dy as above)."""
+    from railopt.models.vehicle.wheelrail import WheelRail
+    from railopt.models.vehicle.wheelset_forces import profile_forces
+
+    ys, table = s1002_uic60
+    wr = WheelRail(conicity=0.2, r0=table.r0, e0=0.75, creep=NO_CREEP, axle_load=W)
+    f = profile_forces(wr, table, kind="linear")
+    k = np.searchsorted(table.y, ys)
+    dh = (table.axle_height[k + 1] - table.axle_height[k - 1]) / 2e-6
+    z = np.zeros(ys.size)
+    np.testing.assert_allclose(f.generalized_forces(ys, z, *rates(ys.size), speed=30.0)[1], -W * dh, rtol=1e-5)
+    with pytest.raises(ValueError, match="rolling radius"):
+        profile_forces(WheelRail(conicity=0.2, r0=0.45, e0=0.75, creep=NO_CREEP, axle_load=W), table)
