@@ -536,7 +536,8 @@ def plot_tradeoff(table: pd.DataFrame, quantity: str, title: str, required: floa
 
 
 BOUNDARY_STYLES = (("k", "--"), ("C1", ":"), ("C2", "-."), ("C4", "--"))
-MARK_STYLES = (("r", "*", 15), ("w", "X", 9), ("C1", "P", 9))
+# later marks larger: visible behind a star on the same point
+MARK_STYLES = (("r", "*", 13), ("w", "X", 19), ("C1", "P", 19))
 
 
 def plot_surfaces(constrained: Surface, unconstrained: Surface, title: str, boundaries: Sequence[Boundary] = (),
