@@ -547,15 +547,19 @@ def _cached(key: str) -> Profile:
 def load_profile(name_or_path: str | Path, kind: str | None = None, **kw: object) -> Profile:
     """A profile by catalogue name (:data:`PROFILE_NAMES`, case and ``-``/``_``/space insensitive:
     ``"S1002"``, ``"60E1"``, ``"UIC60"``, ``"R-UIC 519-A"``) or by path (``.prw``/``.prr`` → SIMPACK,
-    anything else → two-column CSV in mm, which then needs ``kind``).  Extra keywords go to the loader.
+    anything else → two-column CSV in mm, which then needs ``kind``).  Extra keywords go to the loader.  With a
+    catalogue name, ``kind`` (when given) must be the profile's own: a wheel where a rail is wanted is an error.
 
     Raises
     ------
     ValueError
         Unknown name (listing the catalogue), missing file, or the loader's errors.
     """
-    if isinstance(name_or_path, str) and _key(name_or_path) in CATALOGUE and not kw and kind is None:
-        return _cached(_key(name_or_path))
+    if isinstance(name_or_path, str) and _key(name_or_path) in CATALOGUE and not kw:
+        profile = _cached(_key(name_or_path))
+        if kind is not None and profile.kind != kind:
+            raise ValueError(f"profile: {name_or_path!r} is a {profile.kind} profile, not a {kind} profile")
+        return profile
     path = Path(name_or_path)
     if not path.is_file():
         raise ValueError(f"profile: {str(name_or_path)!r} is neither a catalogue name ({', '.join(PROFILE_NAMES)}) "

@@ -12,6 +12,7 @@ nothing is written anywhere.  Warnings about values that load but look wrong (un
 from __future__ import annotations
 
 import ast
+import functools
 import math
 import operator
 from collections.abc import Mapping
@@ -32,10 +33,11 @@ from railopt.models.vehicle.schema import (
     LengthSchema,
     TrackSchema,
     VehicleFileSchema,
+    WheelRailSchema,
     did_you_mean,
     validate_file,
 )
-from railopt.models.vehicle.spec import ConstraintSpec, ContactSpec, Lengths, TrackSpec
+from railopt.models.vehicle.spec import ConstraintSpec, ContactSpec, Lengths, TrackSpec, WheelRailSpec
 from railopt.models.vehicle.vehicle import Vehicle
 from railopt.models.vehicle.wheelrail import Creep
 from railopt.tomlfile import read_toml
@@ -219,7 +221,8 @@ def _parse(data: Mapping[str, Any], path: str, length_overrides: Mapping[str, fl
     _check_ids(f, elements)
 
     constraints = [_constraint(i, c, names, known) for i, c in enumerate(f.constraints)]
-    contact = _contact(f.contact, names)
+    profiles = _wheel_rail(f.wheel_rail, names, path)
+    contact = _contact(f.contact, names, profiles)
     if contact is None and any(b.kind == "wheelset" for b in bodies):
         raise ValueError("missing [contact] table: the vehicle has wheelsets")
     track = _track(f.track, names)
@@ -227,6 +230,7 @@ def _parse(data: Mapping[str, Any], path: str, length_overrides: Mapping[str, fl
 
     vehicle = Vehicle(name=name, description=f.vehicle.description, bodies=tuple(bodies),
                       elements=tuple(elements), constraints=tuple(constraints), contact=contact, track=track,
+                      profiles=profiles,
                       cab_point=cab_point, lengths=Lengths(lengths, lsources),
                       clearances=_clearances(f.clearances), aliases={}, path=path)
     _check_aliases(vehicle, f.aliases)
@@ -399,13 +403,77 @@ def _num(t: Any, key: str, names: Mapping[str, float], table: str, positive: boo
     return x
 
 
-def _contact(t: ContactSchema | None, names: Mapping[str, float]) -> ContactSpec | None:
+def _wheel_rail(t: WheelRailSchema | None, names: Mapping[str, float], path: str) -> WheelRailSpec | None:
+    """``[wheel_rail]``: numbers evaluated, each profile a catalogue name or a file (relative to the vehicle file),
+    loaded once here so that a wrong name or a bad file is an error naming its key."""
     if t is None:
+        return None
+    from railopt.models.contact import PROFILE_NAMES, load_profile
+    from railopt.models.contact.profiles import _key
+
+    sources = {}
+    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail")):
+        raw = getattr(t, key)
+        if _key(raw) in {_key(n) for n in PROFILE_NAMES}:
+            source = raw
+        else:
+            where = Path(raw) if Path(raw).is_absolute() else Path(path).resolve().parent / raw
+            if not where.is_file():
+                raise ValueError(f"wheel_rail.{key}: {raw!r} is neither a profile name ({', '.join(PROFILE_NAMES)}) "
+                                 f"nor a file (looked for {where})")
+            source = str(where)
+        try:
+            load_profile(source, kind)
+        except ValueError as exc:
+            raise ValueError(f"wheel_rail.{key}: {exc}") from None
+        sources[key] = source
+    inclination = _num(t, "inclination", names, "wheel_rail", lower=0.0, upper=0.1)
+    return WheelRailSpec(
+        wheel_profile=sources["wheel_profile"], rail_profile=sources["rail_profile"], inclination=inclination,
+        gauge=_num(t, "gauge_m", names, "wheel_rail", lower=1.0, upper=2.0),
+        flange_back=_num(t, "flange_back_m", names, "wheel_rail", lower=0.9, upper=2.0),
+        conicity_amplitude=_num(t, "conicity_amplitude_m", names, "wheel_rail", positive=True, upper=0.012),
+        friction_coefficient=_num(t, "friction_coefficient", names, "wheel_rail", positive=True, upper=1.0),
+        source=t.source)
+
+
+@functools.lru_cache(maxsize=32)
+def _profile_conicity(profiles: WheelRailSpec, r0: float, e0: float) -> float:
+    """The EN 15302 equivalent conicity of the ``[wheel_rail]`` profile pair at its ``conicity_amplitude`` (from a
+    0.1 mm rigid-contact table, about 1 s: kept per profile pair, placement and radius; a profile file is named
+    by its path — edit a file and load it in a new process)."""
+    from railopt.models.contact import WheelsetTrack, equivalent_conicity, load_profile, rigid_contact_table
+
+    try:
+        track = WheelsetTrack.symmetric(load_profile(profiles.wheel_profile, "wheel"),
+                                        load_profile(profiles.rail_profile, "rail"), gauge=profiles.gauge,
+                                        flange_back_distance=profiles.flange_back, r0=r0,
+                                        inclination=profiles.inclination)
+    except ValueError as exc:
+        raise ValueError(f"wheel_rail: the profiles cannot be placed on the track ({exc})") from None
+    reach = max(0.012, 2.0 * profiles.conicity_amplitude)
+    table = rigid_contact_table(track, np.linspace(-reach, reach, int(round(2.0 * reach / 1e-4)) + 1))
+    try:
+        return equivalent_conicity(table.y, table.delta_r, profiles.conicity_amplitude, r0=r0, e0=e0)
+    except ValueError as exc:
+        raise ValueError(f"wheel_rail.conicity_amplitude_m: {exc}") from None
+
+
+def _contact(t: ContactSchema | None, names: Mapping[str, float],
+             profiles: WheelRailSpec | None = None) -> ContactSpec | None:
+    if t is None:
+        if profiles is not None:
+            raise ValueError("wheel_rail: needs a [contact] table (wheel_radius_m, semi_gauge_m, creep data)")
         return None
     r0 = _num(t, "wheel_radius_m", names, "contact", positive=True)
     e0 = _num(t, "semi_gauge_m", names, "contact", positive=True)
     if t.conicity is not None:
         lam = _num(t, "conicity", names, "contact", lower=0.0)
+    elif t.delta_r_m is None:
+        if profiles is None:
+            raise ValueError("contact.conicity: missing; give conicity, a Δr table (delta_r_y_m, delta_r_m, "
+                             "amplitude_m) or a [wheel_rail] table of profiles")
+        lam = _profile_conicity(profiles, r0, e0)
     else:
         from railopt.models.contact import equivalent_conicity
 

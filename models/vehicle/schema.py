@@ -259,9 +259,8 @@ class ContactSchema(Strict):
 
     @model_validator(mode="after")
     def _complete(self) -> ContactSchema:
-        if self.conicity is None:
-            if self.delta_r_m is None and self.delta_r_y_m is None:
-                raise ValueError("give conicity or a Δr table (delta_r_y_m, delta_r_m, amplitude_m)")
+        if self.conicity is None and (self.delta_r_m is not None or self.delta_r_y_m is not None):
+            # neither conicity nor a table: the conicity comes from [wheel_rail]'s profiles (checked by the loader)
             for key in ("delta_r_y_m", "delta_r_m", "amplitude_m"):
                 if getattr(self, key) is None:
                     raise ValueError(f"missing {key} (a Δr table needs delta_r_y_m, delta_r_m and amplitude_m)")
@@ -272,6 +271,19 @@ class ContactSchema(Strict):
                 if getattr(self, key) is None:
                     raise ValueError(f"missing {key} (creep = 'given' needs f11_N and f22_N)")
         return self
+
+
+class WheelRailSchema(Strict):
+    """``[wheel_rail]``: the wheel and rail profiles of every wheelset (contact geometry, EN 15302 conicity)."""
+
+    wheel_profile: Str
+    rail_profile: Str
+    inclination: Num
+    gauge_m: Num = 1.435
+    flange_back_m: Num = 1.360
+    conicity_amplitude_m: Num = 0.003
+    friction_coefficient: Num = 0.4
+    source: Str = "estimate"
 
 
 class TrackSchema(Strict):
@@ -297,16 +309,20 @@ class VehicleFileSchema(Strict):
     elements: list[ElementSchema] = []
     constraints: list[ConstraintSchema] = []
     contact: ContactSchema | None = None
+    wheel_rail: WheelRailSchema | None = None
     track: TrackSchema | None = None
 
 
 TABLES: dict[str, type[Strict]] = {
     "vehicle": HeadSchema, "cab": CabSchema, "bodies": BodySchema, "elements": ElementSchema,
-    "constraints": ConstraintSchema, "contact": ContactSchema, "track": TrackSchema, "lengths": LengthSchema,
+    "constraints": ConstraintSchema, "contact": ContactSchema, "wheel_rail": WheelRailSchema, "track": TrackSchema,
+    "lengths": LengthSchema,
     "angles_deg": LengthSchema, "clearances": LengthSchema,
 }
 ARRAYS = ("bodies", "elements", "constraints")
-MISSING_HINTS = {"kind": ' (kind = "body" or "wheelset": a wheelset gets wheel/rail contact)'}
+MISSING_HINTS = {"kind": ' (kind = "body" or "wheelset": a wheelset gets wheel/rail contact)',
+                 "inclination": ' (the rail inclination as a slope: "1/40", "1/20"; 0 when the rail profile\'s data '
+                                'are already inclined)'}
 
 
 # ---------------------------------------------------------------------------------------------- errors
@@ -400,6 +416,6 @@ __all__ = [
     "ARRAYS", "AXES", "BODY_KINDS", "BodySchema", "Bool", "CONSTRAINT_KINDS", "CREEP_MODES", "CabSchema",
     "ConstraintSchema", "ContactSchema", "Dofs", "ELEMENT_KINDS", "ElementSchema", "HeadSchema", "Inertia",
     "Length", "LengthSchema", "MAX_EXPRESSION", "MISSING_HINTS", "Num", "Numbers", "Str", "Strict", "TABLES",
-    "TrackSchema", "VALUE_KEYS", "Vec3", "VehicleFileSchema", "ZERO", "did_you_mean", "format_errors",
-    "item_label", "key_path", "validate_file",
+    "TrackSchema", "VALUE_KEYS", "Vec3", "VehicleFileSchema", "WheelRailSchema", "ZERO", "did_you_mean",
+    "format_errors", "item_label", "key_path", "validate_file",
 ]

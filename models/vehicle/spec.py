@@ -76,6 +76,27 @@ class ContactSpec:
 
 
 @dataclass(frozen=True)
+class WheelRailSpec:
+    """The file's ``[wheel_rail]`` table (SI): the profiles every wheelset runs on, placed on the track.
+
+    ``wheel_profile``/``rail_profile`` are catalogue names (:data:`railopt.models.contact.PROFILE_NAMES`) or
+    absolute paths (the loader resolves a path relative to the vehicle file); ``inclination`` the rail inclination
+    applied to the rail profile (tan of the angle: 1/40; 0 for a profile already inclined); ``gauge`` and
+    ``flange_back`` (back-to-back distance) in m; ``conicity_amplitude`` the wheelset amplitude ŷ (m) at which the
+    linear model's equivalent conicity is taken from the profiles (EN 15302; 3 mm by default);
+    ``friction_coefficient`` μ of the saturated creep forces of the nonlinear model."""
+
+    wheel_profile: str
+    rail_profile: str
+    inclination: float
+    gauge: float = 1.435
+    flange_back: float = 1.360
+    conicity_amplitude: float = 0.003
+    friction_coefficient: float = 0.4
+    source: str = "estimate"
+
+
+@dataclass(frozen=True)
 class TrackSpec:
     """Per-rail track data for the lumped model (4.33)–(4.39), (4.49)."""
 
@@ -102,4 +123,4 @@ class Lengths:
     sources: dict[str, str] = field(default_factory=dict)
 
 
-__all__ = ["CONSTRAINT_TYPES", "CREEP_MODES", "ConstraintSpec", "ContactSpec", "Lengths", "TrackSpec"]
+__all__ = ["CONSTRAINT_TYPES", "CREEP_MODES", "ConstraintSpec", "ContactSpec", "Lengths", "TrackSpec", "WheelRailSpec"]

@@ -69,6 +69,7 @@ class VehicleSummary:
     modes: pd.DataFrame = field(repr=False)
     critical: dict = field(default_factory=dict)
     warnings: list[PlausibilityWarning] = field(default_factory=list)
+    contact: list[tuple[str, str]] = field(default_factory=list)
 
     def __repr__(self) -> str:
         crit = ", ".join(f"{k} {c.speed:.2f} m/s" for k, c in self.critical.items())
@@ -89,6 +90,8 @@ class VehicleSummary:
             txt = ", ".join(f"{w / 1000:.1f} kN ({w / GRAVITY / 1000:.2f} t)" for w in loads)
             rows += [(f"axle load ({len(self.axle_loads)} wheelsets)", txt)]
         out += _table(["quantity", "value"], rows, markdown) + [""]
+        if self.contact:
+            out += [f"{h}Wheel/rail contact", ""] + _table(["quantity", "value"], self.contact, markdown) + [""]
         out += [f"{h}Critical speeds (lateral, {SPEED_RANGE[0]:g}-{SPEED_RANGE[1]:g} m/s, tol {TOL} m/s)", ""]
         crit = []
         for track, c in self.critical.items():
@@ -169,7 +172,57 @@ def vehicle_summary(vehicle: Vehicle, speed: float | None = None, track: str = "
             critical[t] = critical_speed(vehicle, track=t, speed_range=SPEED_RANGE, tol=TOL)
     return VehicleSummary(name=vehicle.name, path=vehicle.path, speed=float(speed), track=track,
                           total_mass=vehicle.total_mass, mass_by_kind=by_kind, axle_loads=loads, cg=cg,
-                          modes=modes, critical=critical, warnings=plausibility(vehicle))
+                          modes=modes, critical=critical, warnings=plausibility(vehicle),
+                          contact=contact_rows(vehicle))
+
+
+AMPLITUDES_MM = (1.0, 2.0, 3.0, 4.0, 5.0)
+"""Wheelset amplitudes ŷ (mm) at which the summary lists the profiles' equivalent conicity (EN 15302)."""
+
+
+def contact_rows(vehicle: Vehicle) -> list[tuple[str, str]]:
+    """The summary's wheel/rail rows: the conicity the linear model uses and where it comes from; with
+    ``[wheel_rail]`` profiles, the pair, and their EN 15302 equivalent conicity at :data:`AMPLITUDES_MM` with the
+    lateral shift where flange contact begins (the left contact angle passing 45° as the wheelset moves left)."""
+    c = vehicle.contact
+    if c is None:
+        return []
+    w = vehicle.profiles
+    stated = "[contact] conicity" if w is None or not _from_profiles(vehicle) else (
+        f"[wheel_rail] profiles, EN 15302 at {w.conicity_amplitude * 1e3:g} mm")
+    rows = [("conicity of the linear model", f"{c.conicity:.4g} ({stated})")]
+    if w is None:
+        return rows
+    from railopt.models.contact import equivalent_conicity
+
+    table = vehicle.contact_table()
+    rows.append(("profiles", f"{w.wheel_profile} on {w.rail_profile} inclined {w.inclination:.4g}, gauge "
+                             f"{w.gauge * 1e3:g} mm, back-to-back {w.flange_back * 1e3:g} mm"))
+    values = []
+    for a in AMPLITUDES_MM:
+        try:
+            values.append(f"{a:g} mm: {equivalent_conicity(table.y, table.delta_r, a * 1e-3):.3f}")
+        except ValueError:
+            values.append(f"{a:g} mm: –")
+    rows.append(("tan γe of the profiles", ", ".join(values)))
+    steep = np.abs(table.contact_angle_left) > np.radians(45.0)
+    positive = table.y > 0
+    onset = table.y[positive & steep]
+    rows.append(("flange contact from", f"y = {onset[0] * 1e3:.2f} mm" if onset.size else "beyond the table"))
+    return rows
+
+
+def _from_profiles(vehicle: Vehicle) -> bool:
+    """Whether the linear conicity was derived from the profiles (no stated conicity or Δr table in the file)."""
+    from railopt.tomlfile import read_toml
+
+    if not vehicle.path or not vehicle.path.endswith(".toml"):
+        return False
+    try:
+        contact = read_toml(vehicle.path, "vehicle file").get("contact", {})
+    except (OSError, ValueError):
+        return False
+    return "conicity" not in contact and "delta_r_m" not in contact
 
 
 def main_validate_vehicle(path: str) -> tuple[str, int]:

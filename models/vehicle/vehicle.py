@@ -17,7 +17,7 @@ from railopt.models.vehicle.bodies import Body
 from railopt.models.vehicle.constraints import check_reduced_mass
 from railopt.models.vehicle.elements import Element
 from railopt.models.vehicle.geometry import LATERAL_DOFS, VERTICAL_DOFS, point_jacobian, split
-from railopt.models.vehicle.spec import ConstraintSpec, ContactSpec, Lengths, TrackSpec
+from railopt.models.vehicle.spec import ConstraintSpec, ContactSpec, Lengths, TrackSpec, WheelRailSpec
 from railopt.models.vehicle.views import BodyPlace, VehicleView, check_speed
 from railopt.models.vehicle.wheelrail import Creep, WheelRail
 
@@ -51,6 +51,7 @@ class Vehicle:
     constraints: tuple[ConstraintSpec, ...] = ()
     contact: ContactSpec | None = None
     track: TrackSpec | None = None
+    profiles: WheelRailSpec | None = None
     cab_point: tuple[float, float, float] | None = None
     lengths: Lengths = field(default_factory=Lengths)
     clearances: Lengths = field(default_factory=Lengths)
@@ -202,6 +203,37 @@ class Vehicle:
             creep = hertz_creep(c, W / 2.0)
         return WheelRail(conicity=c.conicity, r0=c.r0, e0=c.e0, creep=creep, axle_load=W, theta0=c.theta0,
                          epsilon=c.epsilon, eta=c.eta, spin=c.spin, gravity_stiffness=c.gravity_stiffness)
+
+    def contact_track(self):
+        """The wheelset on its track from the file's ``[wheel_rail]`` profiles: a
+        :class:`~railopt.models.contact.WheelsetTrack` (both wheels the wheel profile at the ``[contact]`` rolling
+        radius, both rails the rail profile inclined by ``inclination``, the gauge and back-to-back distance).
+
+        Raises
+        ------
+        ValueError
+            The vehicle has no ``[wheel_rail]`` table, or the profiles cannot be placed (naming the field)."""
+        from railopt.models.contact import WheelsetTrack, load_profile
+
+        w = self.profiles
+        if w is None:
+            raise ValueError(f"vehicle {self.name!r} has no [wheel_rail] table (wheel and rail profiles)")
+        if self.contact is None:
+            raise ValueError(f"vehicle {self.name!r}: [wheel_rail] needs the [contact] table's wheel_radius_m")
+        return WheelsetTrack.symmetric(load_profile(w.wheel_profile, "wheel"), load_profile(w.rail_profile, "rail"),
+                                       gauge=w.gauge, flange_back_distance=w.flange_back, r0=self.contact.r0,
+                                       inclination=w.inclination)
+
+    def contact_table(self, y_max: float = 0.012, step: float = 1e-4):
+        """Rigid contact geometry of the ``[wheel_rail]`` profiles over −y_max … y_max (m) in steps of ``step``:
+        a :class:`~railopt.models.contact.ContactTable` (cached per range and step)."""
+        from railopt.models.contact import rigid_contact_table
+
+        key = ("contact_table", float(y_max), float(step))
+        if key not in self._cache:
+            n = int(round(2.0 * y_max / step)) + 1
+            self._cache[key] = rigid_contact_table(self.contact_track(), np.linspace(-y_max, y_max, n))
+        return self._cache[key]
 
     def lumped_track(self) -> LumpedTrack:
         """Per-rail lumped track (4.33)–(4.39), roll terms (4.49) with ℓ18 = 2 e0."""
