@@ -240,5 +240,5 @@ def main_validate_vehicle(path: str) -> tuple[str, int]:
     return "\n".join([head] + [f"warning: {w.line()}" for w in warnings]) + "\n", 0
 
 
-__all__ = ["AMPLITUDES_MM", "SPEED_RANGE", "TOL", "VehicleSummary", "contact_rows", "main_validate_vehicle", "mode_table",
-           "vehicle_summary"]
+__all__ = ["AMPLITUDES_MM", "SPEED_RANGE", "TOL", "VehicleSummary", "contact_rows", "main_validate_vehicle",
+           "mode_table", "vehicle_summary"]
