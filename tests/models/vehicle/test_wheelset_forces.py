@@ -100,7 +100,7 @@ def test_normal_forces_do_no_virtual_work(s1002_uic60: tuple[np.ndarray, Contact
     np.testing.assert_allclose(state.forces[1], -W * dh, rtol=1e-5)
     np.testing.assert_allclose(state.Q.sum(axis=0), W, rtol=1e-12)  # vertical balance
     assert np.max(state.points.angle) > math.radians(55.0)  # the flange is reached: the contact angle rises
-    assert state.forces[1][ys == 0.0075][0] < -1.3 * W  # the flange force from the geometry (no spring)
+    assert state.forces[1][ys == 0.0075][0] < -1.6 * W  # the flange force from the geometry (no spring)
 
 
 def test_balance_with_saturated_creep(s1002_uic60: tuple[np.ndarray, ContactTable]) -> None:
