@@ -82,6 +82,17 @@ def test_linearised_critical_speed(pair) -> None:
     assert found == pytest.approx(cs.speed, rel=1e-9)
 
 
+@pytest.mark.parametrize("name", VEHICLES)
+def test_full_block_linearisation(name: str) -> None:
+    """All coordinates (block "full"): the wheelsets' fore-aft and pitch rows (longitudinal creep (4.40),
+    (4.42)) join; the linearisation equals ``vehicle.full()``'s state matrix at 30 m/s to 1e-9."""
+    vehicle = load_vehicle(name)
+    model = nonlinear_vehicle(vehicle, block="full")
+    view = vehicle.full("rigid")
+    assert model.coordinates == view.coordinates
+    assert rel(central_differences(model, 30.0), view.at(30.0).state_matrix()) < 1e-9
+
+
 def test_contact_plane_model_linearises_to_the_linear_model_without_contact_angle() -> None:
     """The coach (θ0 = ε = 0): creep in the contact plane with the spin of the inclined contact changes nothing
     to first order, so the physical model's linearisation is the linear model too."""
