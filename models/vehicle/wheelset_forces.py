@@ -45,7 +45,8 @@ Flange contact comes from the same geometry: near the flange the contact angle g
 the flange force.  A separate dead-band flange spring (:class:`FlangeSpring`) is only added when asked for
 (published benchmark models that use one).
 
-Limits: rigid track only (a flexible, lumped track needs the track roll and the rail's lateral motion in the
+Limits: the spin of the inclined contact takes δ in the track frame (the roll φ is left out of δ − σφ);
+rigid track only (a flexible, lumped track needs the track roll and the rail's lateral motion in the
 contact: not built, :func:`railopt.models.vehicle.nonlinear.nonlinear_vehicle` refuses it); small yaw
 (γ, not sin γ, in the creepages); the contact point stays in the axle plane (the yaw shift r tan δ γ is left
 out, as in the rigid tables); one contact point per wheel (two-point contact is the table's nearest point);

@@ -104,6 +104,28 @@ def test_contact_plane_model_linearises_to_the_linear_model_without_contact_angl
     assert rel(central_differences(model, 35.0), linear.state_matrix()) < 1e-9
 
 
+def test_vectorised_jacobian_at_a_saturated_state() -> None:
+    """``jacobian`` pushes its 4n perturbed states through the forces in one call; away from x = 0, with
+    saturated creep on a contact table, it equals column-by-column central differences of ``rhs`` (same
+    step, so the difference is round-off and the normal-load iteration's 1e-10 W)."""
+    from railopt.models.contact.rigid_contact import ContactTable
+    from railopt.models.vehicle.wheelset_forces import profile_forces
+
+    vehicle = load_vehicle("manchester-coach")
+    wr = vehicle.wheel_rail()
+    table = ContactTable.conical(0.15, np.linspace(-0.01, 0.01, 81), r0=wr.r0, e0=wr.e0)
+    model = nonlinear_vehicle(vehicle, profile_forces(wr, table, SaturatedCreepLaw(0.3)))
+    x = 1e-3 * np.random.default_rng(1).standard_normal(2 * model.n_dof)
+    J = model.jacobian(x, 40.0)
+    loop = np.empty_like(J)
+    for j in range(x.size):
+        h = 1e-6 * max(1.0, abs(x[j]))
+        e = np.zeros(x.size)
+        e[j] = h
+        loop[:, j] = (model.rhs(0.0, x + e, 40.0) - model.rhs(0.0, x - e, 40.0)) / (2.0 * h)
+    assert rel(J, loop) < 1e-9
+
+
 def test_errors() -> None:
     vehicle = load_vehicle("single-wheelset")
     with pytest.raises(ValueError, match="rigid track only"):
