@@ -322,8 +322,9 @@ class WheelsetContactState:
 
     Attributes: ``points`` (ContactPoints), creepages ``xi_x``, ``xi_y`` (in the chosen plane), ``xi_sp``
     (1/m), creep forces ``Fx``, ``Fy`` (along the lateral tangent), ``Mz`` (about the normal, N·m), normal
-    loads ``N``, vertical wheel loads ``Q`` and the lateral forces ``Y`` of each wheel on its rail's
-    direction (track y, N), and the generalised forces ``forces`` (5, K) in :data:`FORCE_ROWS` order.
+    loads ``N``; the total contact force of the rail on each wheel in track axes, vertical ``Q`` and lateral
+    ``Y`` (y positive left: a flange force on the left wheel is negative), so ``|Y/Q|`` is the derailment
+    quotient; and the generalised forces ``forces`` (5, K) in :data:`FORCE_ROWS` order.
     """
 
     points: ContactPoints
@@ -437,11 +438,12 @@ class WheelsetForces:
             N_new = np.stack([(rhs_v * arm_n[1] - nz[1] * rhs_r) / det, (nz[0] * rhs_r - arm_n[0] * rhs_v) / det])
             change = float(np.max(np.abs(N_new - N)))
             N = N_new
+            if np.any(N <= 0.0):
+                i = int(np.argmin(np.min(N, axis=0)))
+                raise ValueError(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0) at y = "
+                                 f"{y[i]:.6g} m: the rigid contact no longer applies (derailment)")
             if not self.creep_law.load_dependent:
                 break
-            if np.any(N <= 0.0):
-                raise ValueError(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0) at y = "
-                                 f"{y.tolist()} m: the rigid contact no longer applies (derailment)")
             if change <= 1e-10 * W:  # N balances these forces exactly; they are those of N within 1e-10 W
                 break
         else:
