@@ -5,13 +5,14 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Callable, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import WorkerLost, call, map_unordered
+from railopt.design.parallel import Shipped, WorkerLost, call, map_unordered_groups, resolve, shipping
 from railopt.design.problem import MinimaxProblem
 from railopt.design.result import SolveResult, succeeded
 from railopt.design.runner import Runner
@@ -23,15 +24,18 @@ from railopt.design.store import CampaignStore
 @dataclass(frozen=True)
 class _StartBatch:
     """Starts shipped to a worker as one task (NLopt objects are built there, inside :func:`solve`), solved one
-    after the other: one start, or several short ones (dask's per-task cost amortised)."""
+    after the other: one start, or several short ones (dask's per-task cost amortised).  ``problem`` is the
+    problem itself (serial) or the :class:`~railopt.design.parallel.Shipped` handle of the copy every worker got
+    once for the campaign (dask)."""
 
-    problem: MinimaxProblem
+    problem: MinimaxProblem | Shipped
     starts: tuple[Start, ...]
     method: str
     options: dict[str, Any]
 
     def __call__(self) -> list[tuple[Start, SolveResult]]:
-        return [(s, solve(self.problem, s.x0, method=self.method, **self.options)) for s in self.starts]
+        problem = resolve(self.problem)
+        return [(s, solve(problem, s.x0, method=self.method, **self.options)) for s in self.starts]
 
 
 @dataclass(frozen=True)
@@ -40,6 +44,7 @@ class _LostBatch:
 
 
 MAX_BATCH = 8  # starts per task at most: a killed campaign redoes at most this many per worker
+COMMIT_TASKS = 32  # finished tasks committed in one store transaction at most (up to 32 × MAX_BATCH starts)
 TASKS_PER_WORKER = 8  # at least this many tasks per worker, so that uneven starts still balance
 TASK_SECONDS = 0.25  # a batch is made about this long: dask's per-task cost is a few ms of the worker's time
 
@@ -108,12 +113,16 @@ def multistart(
     client : Runner, optional
         A dask.distributed.Client (any :class:`~railopt.design.runner.Runner`).
         Runs the starts as dask tasks (one or a batch per task, see ``batch``); ``None`` runs serially in-process.
+        The problem is sent to the workers once for the campaign (:func:`~railopt.design.parallel.shipping`),
+        not with every task.
     store : CampaignStore, optional
-        Finished starts already in it are skipped (resume); new ones are committed as they finish.
+        Finished starts already in it are skipped (resume); new ones are committed as they finish: the starts of
+        the tasks that finished together (at most :data:`COMMIT_TASKS` tasks) in one transaction, never waiting
+        for more.  ``progress`` reports a start only once it is committed.
     options : dict, optional
         Solver options (see :func:`railopt.design.solve.solve`).
     progress : callable(done, total), optional
-        Called after every finished start.
+        Called after every finished start, once it is stored.
     cluster_xtol : float
         Distance (∞-norm in unit-cube coordinates) under which optima count as the same.
     retry_failed : bool
@@ -160,42 +169,52 @@ def multistart(
 
         seconds: list[float] = []  # solve times of the starts recorded so far
 
-        def record(start: Start, result: SolveResult) -> None:
+        def record(rows: list[tuple[Start, SolveResult]]) -> None:
+            """Store ``rows`` in one transaction, then report them: a start reported is a start stored."""
             nonlocal done
-            store.add_start(start.start_id, start.origin, seed, result)
-            seconds.append(result.wall_time)
-            done += 1
-            if progress is not None:
-                progress(done, total)
+            if not rows:
+                return
+            store.add_starts([(start.start_id, start.origin, seed, result) for start, result in rows])
+            for _, result in rows:
+                seconds.append(result.wall_time)
+                done += 1
+                if progress is not None:
+                    progress(done, total)
 
         def run(tasks: list[_StartBatch], on_lost: Callable = _lost_batch) -> list[Start]:
             """Record every start of ``tasks``; return the starts of the tasks that were lost (``on_lost`` may
-            instead give their rows, which are recorded)."""
+            instead give their rows, which are recorded).  The tasks that finished together are committed in one
+            transaction (group commit: never waiting for more results to fill it)."""
             lost: list[Start] = []
-            for out in map_unordered(call, tasks, client=client, on_lost=on_lost):
-                if isinstance(out, _LostBatch):
-                    lost.extend(out.starts)
-                    continue
-                for start, result in out:
-                    record(start, result)
+            for group in map_unordered_groups(call, tasks, client=client, on_lost=on_lost, most=COMMIT_TASKS):
+                rows: list[tuple[Start, SolveResult]] = []
+                for out in group:
+                    if isinstance(out, _LostBatch):
+                        lost.extend(out.starts)
+                    else:
+                        rows.extend(out)
+                record(rows)
             return lost
 
-        def batches(starts: list[Start], size: int) -> list[_StartBatch]:
-            return [_StartBatch(problem, tuple(starts[i:i + size]), method, user_options)
-                    for i in range(0, len(starts), size)]
+        # the problem goes to the workers once for the campaign (nothing to ship when every start is stored)
+        with shipping(client, problem) if todo else nullcontext(problem) as shipped:
 
-        if client is None or batch is not None:
-            suspects = run(batches(todo, int(batch or 1)))
-        else:  # one start per worker first: how long a start takes decides the batch
-            workers = _worker_threads(client)
-            probe, rest = todo[:workers], todo[workers:]
-            suspects = run(batches(probe, 1))
-            size = batch_size(len(rest), workers, float(np.median(seconds)) if seconds else 0.0)
-            suspects += run(batches(rest, size))
-        # A lost task's starts run again one at a time, each alone on the cluster: dask also holds a worker's death
-        # against a task queued there, so only a start that kills two workers by itself is stored as lost.
-        for start in suspects:
-            run(batches([start], 1), on_lost=_lost_starts)
+            def batches(starts: list[Start], size: int) -> list[_StartBatch]:
+                return [_StartBatch(shipped, tuple(starts[i:i + size]), method, user_options)
+                        for i in range(0, len(starts), size)]
+
+            if client is None or batch is not None:
+                suspects = run(batches(todo, int(batch or 1)))
+            else:  # one start per worker first: how long a start takes decides the batch
+                workers = _worker_threads(client)
+                probe, rest = todo[:workers], todo[workers:]
+                suspects = run(batches(probe, 1))
+                size = batch_size(len(rest), workers, float(np.median(seconds)) if seconds else 0.0)
+                suspects += run(batches(rest, size))
+            # A lost task's starts run again one at a time, each alone on the cluster: dask also holds a worker's
+            # death against a task queued there, so only a start that kills two workers by itself is stored as lost.
+            for start in suspects:
+                run(batches([start], 1), on_lost=_lost_starts)
         table = store.starts()
     finally:
         if owned:
@@ -238,5 +257,6 @@ def distinct_optima(table: pd.DataFrame, problem: MinimaxProblem) -> pd.DataFram
 
 
 __all__ = [
-    "MAX_BATCH", "TASKS_PER_WORKER", "TASK_SECONDS", "batch_size", "distinct_optima", "label_clusters", "multistart",
+    "COMMIT_TASKS", "MAX_BATCH", "TASKS_PER_WORKER", "TASK_SECONDS", "batch_size", "distinct_optima",
+    "label_clusters", "multistart",
 ]

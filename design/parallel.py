@@ -31,6 +31,7 @@ main process only, which shuts the cluster down.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import numbers
@@ -307,6 +308,111 @@ def reporting_progress(progress: ProgressCallback | None) -> Iterator[None]:
         _PROGRESS.reset(token)
 
 
+# ---------------------------------------------------------------------- shipping once
+@dataclass(frozen=True)
+class Shipped:
+    """A handle to an object sent once to every worker by :func:`shipping`: what a task carries instead of it.
+
+    ``resolve(handle)`` gives the object back inside a task; the handle itself pickles to a few dozen bytes.
+    """
+
+    name: str
+
+    def get(self) -> Any:
+        """The object, from the worker plugin of this name on the worker running the task.
+
+        Raises ``RuntimeError`` outside a dask worker, or on a worker without the plugin (it was removed: the
+        campaign that shipped it has ended)."""
+        from distributed import get_worker
+
+        try:
+            worker = get_worker()
+        except ValueError:
+            raise RuntimeError(f"{self.name}: a shipped object is resolved only inside a dask task") from None
+        plugin = worker.plugins.get(self.name)
+        if plugin is None:
+            raise RuntimeError(f"{self.name}: not on worker {worker.address} (its campaign has ended, or the "
+                               "plugin was removed)")
+        return plugin.value
+
+
+def resolve(obj: Any) -> Any:
+    """``obj``, or the object a :class:`Shipped` handle stands for (inside a dask task)."""
+    return obj.get() if isinstance(obj, Shipped) else obj
+
+
+def _bounded(fn: Callable[[], Any], wait: float, what: str, info: _ClientInfo) -> Any:
+    """``fn()`` in a thread, given up after ``wait`` + :data:`SCHEDULER_MARGIN` s (a lost scheduler: SchedulerError)."""
+    box: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            box["value"] = fn()
+        except BaseException as exc:  # noqa: BLE001  (re-raised below, in the caller's thread)
+            box["error"] = exc
+
+    thread = threading.Thread(target=target, name=f"railopt-{what}", daemon=True)
+    thread.start()
+    thread.join(wait + SCHEDULER_MARGIN)
+    if thread.is_alive():
+        raise _lost(info, TimeoutError(f"{what}: no answer within {wait + SCHEDULER_MARGIN:g} s"))
+    if "error" in box:
+        raise box["error"]
+    return box.get("value")
+
+
+@contextmanager
+def shipping(client: Runner | None, obj: Any, name: str = "problem") -> Iterator[Any]:
+    """Send ``obj`` to every worker of ``client`` once; within the block, tasks carry the yielded handle.
+
+    With a dask client, ``obj`` goes out as a worker plugin (:class:`~railopt.design._worker_setup.ShippedObject`):
+    the scheduler keeps one pickled copy and gives it to every worker, those that join (or are restarted) later
+    included, and the block's end removes it.  A task then carries a :class:`Shipped` handle of a few dozen bytes
+    and calls :func:`resolve` on it.  Serial (``client`` None), or a :class:`~railopt.design.runner.Runner` without
+    ``register_plugin``: the block yields ``obj`` itself, which the tasks then carry (the same numbers: only the
+    transport differs).
+
+    Measured on 2 cores (``railopt bench``, the flagship's 190 kB problem): the problem pickled and sent with every
+    task held a short-start campaign near 30 tasks/s at 1 and 2 workers; shipped once, the rate follows the
+    workers.
+
+    Raises
+    ------
+    ValueError
+        Before anything is sent, naming the part of ``obj`` that cannot be pickled (``problem.functions...``).
+    SchedulerError
+        The scheduler did not take the plugin within its timeout.
+    """
+    if client is None:
+        yield obj
+        return
+    check_picklable(obj, name)
+    register = getattr(client, "register_plugin", None)
+    if register is None:
+        yield obj
+        return
+    from railopt.design._worker_setup import ShippedObject
+
+    info = _CLIENTS.get(client) or _ClientInfo(_address(client), scheduler_timeout(), True)
+    key = f"railopt-{name}-{os.getpid()}-{next(_SHIPMENTS)}-{time.time_ns():x}"
+    try:
+        _bounded(lambda: register(ShippedObject(key, obj), name=key), info.timeout, "shipping", info)
+    except SchedulerError:
+        raise
+    except (OSError, TimeoutError) as exc:  # the connection broke meanwhile
+        raise _lost(info, exc) from None
+    try:
+        yield Shipped(key)
+    finally:
+        try:  # the scheduler and every worker let go of it; a lost scheduler is not waited on
+            _bounded(lambda: client.unregister_worker_plugin(key), info.timeout, "unshipping", info)
+        except Exception:  # noqa: BLE001, S110  (already gone with its scheduler: nothing is held any more)
+            pass
+
+
+_SHIPMENTS = itertools.count()
+
+
 # ---------------------------------------------------------------------- mapping
 def map_unordered(
     fn: Callable[[Any], Any],
@@ -343,24 +449,53 @@ def map_unordered(
     WorkerLost
         Without ``on_lost``, for a task that killed its workers.
     """
+    for group in map_unordered_groups(fn, items, client, retries, on_lost, progress, most=1):
+        yield from group
+
+
+def map_unordered_groups(
+    fn: Callable[[Any], Any],
+    items: Iterable[Any],
+    client: Runner | None = None,
+    retries: int = 3,
+    on_lost: Callable[[Any, WorkerLost], Any] | None = None,
+    progress: ProgressCallback | None = None,
+    most: int = 32,
+) -> Iterator[list[Any]]:
+    """:func:`map_unordered`, the results given in lists: each list holds a result and those already finished
+    when it was read, ``most`` at most; never waits for a result to fill a list.
+
+    A consumer that does one costly thing per list (a store's transaction) then does it once for a run of
+    results that arrived together, and at once for a result that arrived alone: lists grow only when results
+    come faster than the consumer takes them.  Serially, each list holds one result.  Same parameters and
+    errors as :func:`map_unordered`; ``progress`` is called after each finished task, before its list is given.
+    When the scheduler is lost after some results of a list were read, the list is given first, then
+    :class:`SchedulerError` is raised.
+    """
+    if isinstance(most, bool) or not isinstance(most, numbers.Integral) or most < 1:
+        raise ValueError(f"most: must be a whole number of results >= 1, got {most!r}")
     items = list(items)
     report = progress if progress is not None else _PROGRESS.get()
+    groups = _map(fn, items, client, retries, on_lost, int(most))
     if report is None:
-        yield from _map(fn, items, client, retries, on_lost)
+        yield from groups
         return
     report(0, len(items))
-    for done, result in enumerate(_map(fn, items, client, retries, on_lost), start=1):
-        report(done, len(items))
-        yield result
+    done = 0
+    for group in groups:
+        for _ in group:
+            done += 1
+            report(done, len(items))
+        yield group
 
 
 def _map(fn: Callable[[Any], Any], items: list[Any], client: Runner | None, retries: int,
-         on_lost: Callable[[Any, WorkerLost], Any] | None) -> Iterator[Any]:
-    """:func:`map_unordered` without progress."""
+         on_lost: Callable[[Any, WorkerLost], Any] | None, most: int) -> Iterator[list[Any]]:
+    """:func:`map_unordered_groups` without progress."""
     task = _SingleThreaded(fn)
     if client is None:
         for item in items:
-            yield task(item)
+            yield [task(item)]
         return
     if not items:
         return
@@ -422,14 +557,33 @@ def _map(fn: Callable[[Any], Any], items: list[Any], client: Runner | None, retr
                 else:
                     no_workers_since = None
                 continue
-            if got is None or isinstance(got, Exception):  # the stream of results ended early
-                raise _lost(info, got if isinstance(got, Exception) else None)
-            remaining -= 1
             no_workers_since = unhealthy_since = None
-            key = got.key
-            result = _result(got, item_of.pop(key), info, on_lost)
-            del pending[key], got
-            yield result
+            group: list[Any] = []
+            failure: BaseException | None = None
+            while True:  # this result, then those already waiting (never waiting for more)
+                if got is None or isinstance(got, Exception):  # the stream of results ended early
+                    failure = _lost(info, got if isinstance(got, Exception) else None)
+                    break
+                remaining -= 1
+                key = got.key
+                try:
+                    result = _result(got, item_of.pop(key), info, on_lost)
+                except BaseException as exc:  # the task's own error, or a lost connection: after the group
+                    failure = exc
+                    del pending[key], got
+                    break
+                del pending[key], got
+                group.append(result)
+                if not remaining or len(group) >= most:
+                    break
+                try:
+                    got = finished.get_nowait()
+                except queue.Empty:
+                    break
+            if group:
+                yield group
+            if failure is not None:
+                raise failure
     finally:
         for future in pending.values():  # interrupted: do not leave work queued on a shared cluster
             if not future.done():
@@ -706,6 +860,6 @@ def _unblock_sigint(previous: set[int] | None) -> None:
 __all__ = [
     "DASK_LOGS_ENV", "DEFAULT_SCHEDULER_TIMEOUT", "LOCAL_NO_WORKERS_LIMIT", "SCHEDULER_ENV", "SCHEDULER_MARGIN",
     "SCHEDULER_TIMEOUT_ENV", "ClusterRecord", "ProgressCallback", "SchedulerError", "WorkerLost", "call",
-    "check_picklable", "cluster_record", "cluster_summary", "dask_client", "map_unordered", "reporting_progress",
-    "scheduler_timeout",
+    "Shipped", "check_picklable", "cluster_record", "cluster_summary", "dask_client", "map_unordered",
+    "map_unordered_groups", "reporting_progress", "resolve", "scheduler_timeout", "shipping",
 ]

@@ -1,8 +1,18 @@
 """The campaign store: one SQLite file per campaign, a versioned schema, a reader returning DataFrames.
 
-Every finished start is committed in its own transaction as it streams back, so a killed
-campaign loses at most the starts of the tasks that were running (a task holds one start, or a batch of
-up to 8 short ones); ``--resume`` skips the finished ones.
+Finished starts are committed as they stream back: the starts of the tasks that finished together in one
+transaction (:meth:`CampaignStore.add_starts`, a group commit of at most 32 tasks, never waiting to fill it), and a
+start is reported as done only once committed.  A killed campaign keeps every start it reported; it loses the
+starts of the tasks that were running (a task holds one start, or a batch of up to 8 short ones) and at most
+the one group received but not yet committed; ``--resume`` skips the finished ones.
+
+Local disk only.  A store is written in SQLite's WAL mode, whose index lives in shared memory that processes on
+other hosts do not see ("WAL does not work over a network filesystem", sqlite.org/wal.html), and SQLite's locks
+rely on POSIX locks that many network file systems break (sqlite.org/howtocorrupt.html §2.1).  Creating a store,
+or opening one for writing, on a network or cluster file system (:data:`NETWORK_FILESYSTEMS`, the type of the
+mount holding the path: :func:`network_filesystem`) is refused with a :class:`StoreError` naming the file, the
+file system and its mount point; ``$RAILOPT_STORE_ON_NETWORK_FS=allow`` turns that into a warning and keeps the
+store in the rollback journal.  Read-only opens are allowed anywhere.
 ``start_id`` is the primary key: a start can never be stored twice.  No pickles: vectors are
 JSON, and the campaign config is stored with its SHA-256 so that a resume with a different
 config is refused.
@@ -47,6 +57,7 @@ import math
 import os
 import sqlite3
 import uuid
+import warnings
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from contextlib import closing, contextmanager
 from pathlib import Path
@@ -160,8 +171,130 @@ def _held(path: Path, waited: float) -> StoreError:
                       "process, then run again (a live campaign's store may be read at any time: it is in WAL mode)")
 
 
-def _configure(path: Path, db: sqlite3.Connection, read_only: bool) -> None:
-    """The busy timeout and, for a writer, WAL journal mode (until :meth:`CampaignStore.close`).
+# ---------------------------------------------------------------------- the disk a store is on
+MOUNTS = Path("/proc/mounts")  # Linux: the mount table (device, mount point, type, options, ...)
+NETWORK_STORE_ENV = "RAILOPT_STORE_ON_NETWORK_FS"  # "allow": a store on a network file system, in rollback mode
+# File systems on which SQLite's WAL mode (a shared-memory index, mmap of <store>-shm, coherent only between
+# processes of one host) or its POSIX locks cannot be trusted: network and cluster file systems, and the shared
+# folders of virtual machines.  Linux names (/proc/mounts) and macOS names (psutil); FUSE ones are "fuse.<name>".
+NETWORK_FILESYSTEMS = frozenset({
+    "nfs", "nfs4", "cifs", "smb", "smb2", "smb3", "smbfs", "ncpfs", "afs", "coda", "9p", "v9fs", "vboxsf", "vmhgfs",
+    "prl_fs", "davfs", "webdav", "afpfs", "lustre", "gpfs", "beegfs", "ceph", "glusterfs", "ocfs2", "gfs2",
+    "orangefs", "pvfs2", "fuse.sshfs", "sshfs", "fuse.s3fs", "fuse.rclone", "fuse.gcsfuse", "fuse.glusterfs",
+    "fuse.ceph", "fuse.cephfs", "fuse.juicefs", "fuse.davfs", "fuse.goofys", "fuse.blobfuse", "fuse.blobfuse2",
+    "fuse.vmhgfs-fuse", "fuse.lizardfs", "fuse.moosefs", "fuse.mfs", "fuse.seaweedfs", "fuse.sshfs-fuse",
+    "macfuse", "osxfuse",
+})
+
+
+def _unescape_mount(field: str) -> str:
+    r"""A /proc/mounts field with its octal escapes decoded (``\040`` is a space, ``\011`` a tab, ...)."""
+    out, i = [], 0
+    while i < len(field):
+        if field[i] == "\\" and i + 3 < len(field) and field[i + 1:i + 4].isdigit():
+            out.append(chr(int(field[i + 1:i + 4], 8)))
+            i += 4
+        else:
+            out.append(field[i])
+            i += 1
+    return "".join(out)
+
+
+def parse_mounts(text: str) -> list[tuple[str, str, str]]:
+    """``(mount point, file system type, options)`` of each line of a /proc/mounts table, in order (a later
+    mount on the same point hides an earlier one).  Lines with fewer than four fields are skipped."""
+    rows = []
+    for line in text.splitlines():
+        fields = line.split()
+        if len(fields) >= 4:
+            rows.append((_unescape_mount(fields[1]), fields[2], fields[3]))
+    return rows
+
+
+def _partitions() -> list[tuple[str, str, str]] | None:
+    """The mount table where /proc/mounts is absent (macOS, BSD, Windows): psutil's, or None."""
+    try:
+        import psutil
+
+        return [(d.mountpoint, d.fstype, d.opts) for d in psutil.disk_partitions(all=True)]
+    except Exception:  # noqa: BLE001  (no table: the file system is not known)
+        return None
+
+
+def store_filesystem(path: str | Path, mounts: Sequence[tuple[str, str, str]] | None = None
+                     ) -> tuple[str, str, str] | None:
+    """``(mount point, file system type, options)`` of the mount holding ``path`` (a file or folder that need not
+    exist yet: its nearest existing folder is looked up, links resolved); ``None`` when it cannot be told.
+
+    ``mounts``: a mount table as :func:`parse_mounts` gives it; default the one of :data:`MOUNTS` (Linux), else
+    psutil's (``disk_partitions(all=True)``: macOS, BSD, Windows).  The mount is the one whose mount point is the
+    longest leading part of the path; of two on one point, the later.
+    """
+    here = Path(os.path.abspath(path))
+    while not here.exists() and here != here.parent:
+        here = here.parent
+    real = os.path.realpath(here)
+    if mounts is None:
+        try:
+            mounts = parse_mounts(MOUNTS.read_text())
+        except OSError:
+            mounts = _partitions()
+        if mounts is None:
+            return None
+    best: tuple[str, str, str] | None = None
+    for point, fstype, opts in mounts:
+        norm = os.path.normcase(os.path.normpath(point))
+        target = os.path.normcase(real)
+        inside = target == norm or target.startswith(norm.rstrip(os.sep) + os.sep)
+        if inside and (best is None or len(norm) >= len(os.path.normcase(os.path.normpath(best[0])))):
+            best = (point, fstype, opts)
+    return best
+
+
+def network_filesystem(path: str | Path, mounts: Sequence[tuple[str, str, str]] | None = None) -> str | None:
+    """A description (``"nfs4 at /mnt/data"``) when ``path`` is on a network or cluster file system
+    (:data:`NETWORK_FILESYSTEMS`, a Windows network drive, a UNC path), else ``None`` (a local disk, or not
+    known)."""
+    text = str(path)
+    if text.startswith(("\\\\", "//")) and os.name == "nt":
+        return "a network share (UNC path)"
+    found = store_filesystem(path, mounts)
+    if found is None:
+        return None
+    point, fstype, opts = found
+    remote = "remote" in opts.split(",") and os.name == "nt"  # psutil marks network drives on Windows so
+    if fstype.lower() in NETWORK_FILESYSTEMS or remote:
+        return f"{fstype} at {point}"
+    return None
+
+
+def _local_disk(path: Path, doing: str) -> bool:
+    """Refuse a store to be written on a network file system (:class:`StoreError`); with
+    ``$RAILOPT_STORE_ON_NETWORK_FS=allow`` warn instead and return False (the store then stays in SQLite's rollback
+    journal, not WAL).  True: a local disk (or one not known to be remote): WAL mode.
+
+    Why refused: SQLite's WAL keeps an index in shared memory (``<store>-shm``, mapped by every process), coherent
+    only between processes of one host — "WAL does not work over a network filesystem" (sqlite.org/wal.html,
+    §"Disadvantages") — and its locks rely on the file system's POSIX locks, broken on many network file systems
+    (sqlite.org/howtocorrupt.html §2.1): a store written there can be damaged, and a campaign lost with it."""
+    where = network_filesystem(path)
+    if where is None:
+        return True
+    allowed = os.environ.get(NETWORK_STORE_ENV, "").strip().lower() == "allow"
+    what = (f"store: {path} is on a network file system ({where}); SQLite's write-ahead log needs a local disk "
+            "(its shared-memory index is not shared between hosts) and its locks are unreliable on network file "
+            "systems")
+    if not allowed:
+        raise StoreError(f"{what}: refusing to {doing} it — put the results on a local disk (--results), or set "
+                         f"{NETWORK_STORE_ENV}=allow to use it in SQLite's rollback journal at your own risk")
+    warnings.warn(f"{what}; {NETWORK_STORE_ENV}=allow: using it in the rollback journal, not WAL (no other host "
+                  "may write it; a reader blocks the writer)", RuntimeWarning, stacklevel=3)
+    return False
+
+
+def _configure(path: Path, db: sqlite3.Connection, read_only: bool, wal: bool = True) -> None:
+    """The busy timeout and, for a writer, WAL journal mode (until :meth:`CampaignStore.close`; not with
+    ``wal=False``: a store on a network file system allowed by :data:`NETWORK_STORE_ENV`).
 
     Switching a closed store (rollback journal) to WAL needs every reader gone: a reader holding a read
     transaction is waited for up to :data:`BUSY_TIMEOUT` s, then the open fails with a :class:`StoreError` naming
@@ -169,7 +302,7 @@ def _configure(path: Path, db: sqlite3.Connection, read_only: bool) -> None:
     # every statement is read to its end (a pragma returns a row): one left pending holds the connection's read
     # lock, and close() could not fold the log back (the store stayed in WAL mode with -wal/-shm files beside it)
     db.execute(f"PRAGMA busy_timeout = {int(BUSY_TIMEOUT * 1000)}").fetchall()
-    if read_only:
+    if read_only or not wal:
         return
     try:
         db.execute("PRAGMA journal_mode = WAL").fetchall()
@@ -262,20 +395,23 @@ def _check_store(path: Path, db: sqlite3.Connection, expect_config: Mapping[str,
 class CampaignStore:
     """One campaign's SQLite file.  Use :meth:`create` for a new campaign, :meth:`open` to read/resume."""
 
-    def __init__(self, path: Path, connection: sqlite3.Connection, read_only: bool = False) -> None:
+    def __init__(self, path: Path, connection: sqlite3.Connection, read_only: bool = False, wal: bool = True
+                 ) -> None:
         self.path = Path(path)
         self._db = connection
         self.read_only = read_only
         if str(path) != ":memory:":
-            _configure(self.path, connection, read_only)
+            _configure(self.path, connection, read_only, wal)
 
     # ------------------------------------------------------------------ opening
     @classmethod
     def create(cls, path: str | Path, name: str, config: Mapping[str, Any], variables: list[str]) -> CampaignStore:
-        """Create a new store; refuses to touch an existing file (``FileExistsError``)."""
+        """Create a new store; refuses to touch an existing file (``FileExistsError``), and a path on a network
+        file system (:class:`StoreError`, before anything is made; see :func:`network_filesystem`)."""
         path = Path(path)
         if path.exists():
             raise FileExistsError(f"store: {path} already exists (resume it, or remove it to start afresh)")
+        wal = _local_disk(path, "create")
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
         except (FileExistsError, NotADirectoryError):
@@ -300,7 +436,7 @@ class CampaignStore:
         finally:
             tmp.unlink(missing_ok=True)
         try:
-            return cls(path, sqlite3.connect(path, timeout=BUSY_TIMEOUT))
+            return cls(path, sqlite3.connect(path, timeout=BUSY_TIMEOUT), wal=wal)
         except sqlite3.Error as exc:
             raise _sqlite_error(path, exc, "open") from None
 
@@ -316,9 +452,10 @@ class CampaignStore:
              read_only: bool = False) -> CampaignStore:
         """Open an existing store; with ``expect_config`` refuse one made from another config.
 
-        ``read_only=True`` opens it for reading only (safe on a store a campaign is writing).
-        Raises :class:`StoreDamaged` (naming the file) if it is not an intact campaign store, and
-        :class:`StoreError` (naming it) if it cannot be opened or is of another schema version.
+        ``read_only=True`` opens it for reading only (safe on a store a campaign is writing; allowed on a network
+        file system).  Raises :class:`StoreDamaged` (naming the file) if it is not an intact campaign store, and
+        :class:`StoreError` (naming it) if it cannot be opened, is of another schema version, or is opened for
+        writing on a network file system (:func:`network_filesystem`).
         """
         path = Path(path)
         if not path.exists():
@@ -331,6 +468,7 @@ class CampaignStore:
             raise StoreDamaged(path, "empty file")
         if header != _HEADER:
             raise StoreDamaged(path, "not an SQLite database: bad header")
+        wal = True if read_only else _local_disk(path, "write")
         try:
             db = sqlite3.connect(f"{path.resolve().as_uri()}?mode={'ro' if read_only else 'rw'}", uri=True,
                                  timeout=BUSY_TIMEOUT)
@@ -338,7 +476,7 @@ class CampaignStore:
             raise _sqlite_error(path, exc, "open") from None
         try:
             _check_store(path, db, expect_config)
-            return cls(path, db, read_only)
+            return cls(path, db, read_only, wal)
         except BaseException as exc:
             db.close()
             if isinstance(exc, sqlite3.Error):
@@ -394,16 +532,41 @@ class CampaignStore:
         A start already stored raises :class:`DuplicateStart`, unless its stored status is one of
         :data:`RETRYABLE_STATUSES` (a retried start): then the new result replaces it.
         """
-        with self._writing(f"start {start_id}"):
-            self._db.execute(f"DELETE FROM starts WHERE start_id = ? AND status IN ({_marks(RETRYABLE_STATUSES)})",
-                             (int(start_id), *RETRYABLE_STATUSES))
-            self._db.execute(
-                "INSERT INTO starts VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
-                (int(start_id), origin, _vec(result.x0), _vec(result.x), _num(result.value), _num(result.t),
-                 result.status, result.message, int(result.evaluations), float(result.wall_time), result.method,
-                 int(seed), float(result.constraint_violation), float(result.bound_violation),
-                 _vec(result.functions), _now()),
-            )
+        self.add_starts([(start_id, origin, seed, result)])
+
+    def add_starts(self, rows: Iterable[tuple[int, str, int, Any]]) -> None:
+        """Record finished starts ``(start_id, origin, seed, result)`` in one transaction: all of them or none.
+
+        A group commit: one commit (the costly part of a write: its fsync, 0.5–4 ms on a local disk) for many
+        starts, so that a campaign of short starts on many workers is not bound by the store.  Rules per start as
+        :meth:`add_start`; a start already stored raises :class:`DuplicateStart` naming it, and nothing of the
+        group is written.
+        """
+        rows = list(rows)
+        if not rows:
+            return
+        ids = [int(r[0]) for r in rows]
+        what = f"start {ids[0]}" if len(ids) == 1 else f"starts {ids[0]}, …, {ids[-1]} ({len(ids)} starts)"
+        current = ids[0]
+        try:
+            with self._db:
+                for start_id, origin, seed, result in rows:
+                    current = int(start_id)
+                    self._db.execute(
+                        f"DELETE FROM starts WHERE start_id = ? AND status IN ({_marks(RETRYABLE_STATUSES)})",
+                        (current, *RETRYABLE_STATUSES))
+                    self._db.execute(
+                        "INSERT INTO starts VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
+                        (current, origin, _vec(result.x0), _vec(result.x), _num(result.value), _num(result.t),
+                         result.status, result.message, int(result.evaluations), float(result.wall_time),
+                         result.method, int(seed), float(result.constraint_violation),
+                         float(result.bound_violation), _vec(result.functions), _now()),
+                    )
+        except sqlite3.IntegrityError as exc:
+            raise DuplicateStart(f"store: {self.path}: start {current} is already stored ({exc}); is another run "
+                                 "writing to this campaign?") from None
+        except sqlite3.Error as exc:
+            raise _sqlite_error(self.path, exc, f"write {what} to") from None
 
     def add_check(self, start_id: int, name: str, value: float, payload: Mapping[str, Any] | None = None) -> None:
         """Record a check of an optimum (e.g. a critical speed); replaces an earlier one of that name."""
@@ -471,6 +634,7 @@ class CampaignStore:
 
 
 __all__ = [
-    "BUSY_TIMEOUT", "RETRYABLE_STATUSES", "SCHEMA_VERSION", "TABLES", "CampaignStore", "DuplicateStart",
-    "StoreDamaged", "StoreError", "config_hash",
+    "BUSY_TIMEOUT", "MOUNTS", "NETWORK_FILESYSTEMS", "NETWORK_STORE_ENV", "RETRYABLE_STATUSES", "SCHEMA_VERSION",
+    "TABLES", "CampaignStore", "DuplicateStart", "StoreDamaged", "StoreError", "config_hash", "network_filesystem",
+    "parse_mounts", "store_filesystem",
 ]
