@@ -22,6 +22,11 @@ the workers lost while a map ran and how many of its tasks they were running —
 other workers, which changes no result (every task is self-contained) but must be said (``railopt run`` prints it
 and writes it to ``timing.csv``).
 
+Shipping.  A campaign's problem goes to the workers once (:func:`shipping`, a worker plugin the scheduler also
+gives to workers that join later), and its tasks carry a :class:`Shipped` handle instead of the problem.
+:func:`map_unordered_groups` gives the results that finished together in one list, for a consumer that does one
+costly thing per list (the campaign store's group commit).
+
 Logs.  While a client made by :func:`dask_client` is open, dask's own log lines (warnings about
 restarted workers, cancelled instructions at shutdown) are kept out of the terminal: set
 ``$RAILOPT_DASK_LOGS`` to a level name (e.g. ``WARNING``) to see them.  The workers of the embedded
@@ -368,7 +373,10 @@ def shipping(client: Runner | None, obj: Any, name: str = "problem") -> Iterator
     With a dask client, ``obj`` goes out as a worker plugin (:class:`~railopt.design._worker_setup.ShippedObject`):
     the scheduler keeps one pickled copy and gives it to every worker, those that join (or are restarted) later
     included, and the block's end removes it.  A task then carries a :class:`Shipped` handle of a few dozen bytes
-    and calls :func:`resolve` on it.  Serial (``client`` None), or a :class:`~railopt.design.runner.Runner` without
+    and calls :func:`resolve` on it.  A plugin rather than ``client.scatter``: scattered data lives on the workers
+    only, and is gone when the workers holding it die (a start that crashes the one worker of a cluster would take
+    the problem with it, and every later task would fail); the scheduler keeps a plugin and gives it to the
+    restarted worker.  Serial (``client`` None), or a :class:`~railopt.design.runner.Runner` without
     ``register_plugin``: the block yields ``obj`` itself, which the tasks then carry (the same numbers: only the
     transport differs).
 
