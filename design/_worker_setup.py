@@ -12,6 +12,7 @@ so the tasks of a campaign carry only the plugin's name (:class:`railopt.design.
 
 from __future__ import annotations
 
+import logging
 import signal
 import threading
 from typing import Any
@@ -22,10 +23,28 @@ except ImportError:  # the preload runs in a dask worker, where distributed is t
     WorkerPlugin = object  # type: ignore[assignment,misc]
 
 
+SCHEDULER_GONE = "Failed to communicate with scheduler during heartbeat"
+"""The worker log record dropped in the embedded cluster: its scheduler lives in the main process, so when it is
+gone the main process is shutting the cluster down (Ctrl-C, the end of a run) or has failed and says so itself;
+the worker's ERROR with a traceback would only add noise to what the user reads."""
+
+
+class SchedulerGone(logging.Filter):
+    """Drops the :data:`SCHEDULER_GONE` records of the ``distributed.worker`` logger."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        """False for a heartbeat failure (dropped), True for everything else."""
+        return SCHEDULER_GONE not in record.getMessage()
+
+
 def dask_setup(worker: object = None) -> None:
-    """Ignore SIGINT in this worker process (only possible from its main thread, where dask runs it)."""
+    """Ignore SIGINT in this worker process (only possible from its main thread, where dask runs it), and drop the
+    heartbeat failures a worker logs when the main process closes the scheduler first (:class:`SchedulerGone`)."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    log = logging.getLogger("distributed.worker")
+    if not any(isinstance(f, SchedulerGone) for f in log.filters):
+        log.addFilter(SchedulerGone())
 
 
 class ShippedObject(WorkerPlugin):  # type: ignore[misc,valid-type]
@@ -46,4 +65,4 @@ class ShippedObject(WorkerPlugin):  # type: ignore[misc,valid-type]
         self.value = None
 
 
-__all__ = ["ShippedObject", "dask_setup"]
+__all__ = ["SCHEDULER_GONE", "SchedulerGone", "ShippedObject", "dask_setup"]
