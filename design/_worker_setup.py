@@ -57,7 +57,8 @@ class ShippedObject(WorkerPlugin):  # type: ignore[misc,valid-type]
         self.name = name
         self.value = value
 
-    def setup(self, worker: Any) -> None:  # noqa: D102  (nothing to do: the value came with the plugin)
+    def setup(self, worker: Any) -> None:
+        """Nothing to do: the value came with the plugin."""
         return None
 
     def teardown(self, worker: Any) -> None:

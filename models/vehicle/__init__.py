@@ -7,7 +7,9 @@ A one-way pipeline: file (:func:`load_vehicle`) → definition (:class:`Vehicle`
 (:mod:`~railopt.models.vehicle.forced`).  ``view.family(names, input, outputs)`` is the
 :class:`~railopt.models.parametric.ParametricSystem` with its speed term that stability, forced
 response and design use (``docs/forced_response.md``).
-Schema, coordinates and conventions: ``docs/vehicle.md``.
+Schema, coordinates and conventions: ``docs/vehicle.md``.  The nonlinear vehicle (the same suspension, wheel/rail
+forces from profiles with creep saturation): :func:`nonlinear_vehicle` → :class:`NonlinearVehicle`
+(``docs/nonlinear_vehicle.md``).
 """
 
 from railopt.models.vehicle.assembly import Assembly, assemble
@@ -17,6 +19,7 @@ from railopt.models.vehicle.forced import forced_parametric, forced_system, freq
 from railopt.models.vehicle.geometry import DOFS, LATERAL_DOFS, THESIS_SIGNS, VERTICAL_DOFS
 from railopt.models.vehicle.irregularity import Irregularity, RailInput
 from railopt.models.vehicle.loader import BUNDLED, VehicleFileError, load_vehicle, parse_vehicle
+from railopt.models.vehicle.nonlinear import NonlinearVehicle, nonlinear_vehicle
 from railopt.models.vehicle.outputs import PointOutput
 from railopt.models.vehicle.vehicle import Vehicle
 from railopt.models.vehicle.views import VehicleModel, VehicleView
@@ -33,6 +36,7 @@ __all__ = [
     "Creep",
     "Element",
     "Irregularity",
+    "NonlinearVehicle",
     "PointOutput",
     "RailInput",
     "Vehicle",
@@ -45,5 +49,6 @@ __all__ = [
     "forced_system",
     "frequency_response",
     "load_vehicle",
+    "nonlinear_vehicle",
     "parse_vehicle",
 ]

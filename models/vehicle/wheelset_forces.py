@@ -102,7 +102,9 @@ class ContactGeometry(Protocol):
 
     r0: float
 
-    def points(self, y: np.ndarray) -> ContactPoints: ...
+    def points(self, y: np.ndarray) -> ContactPoints:
+        """Contact points of both wheels at the lateral shifts ``y`` (m, shape (K,)): radii, angles and arms."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -130,6 +132,7 @@ class ConicalGeometry:
         return cls(wr.conicity, wr.r0, wr.e0, wr.theta0, wr.epsilon, wr.eta)
 
     def points(self, y: np.ndarray) -> ContactPoints:
+        """The conical contact points at ``y`` (m, (K,)): exact in y, Δr = 2λy, tan δ = θ0 ± εy/e0."""
         y = np.asarray(y, dtype=float)[None, :]
         sigma = SIDES
         return ContactPoints(
@@ -199,6 +202,7 @@ class TabulatedGeometry:
                    kind=kind)
 
     def points(self, y: np.ndarray) -> ContactPoints:
+        """The table's contact points interpolated at ``y`` (m, (K,)); ValueError naming the table outside it."""
         y = np.asarray(y, dtype=float)
         if y.size and (np.min(y) < self.y[0] or np.max(y) > self.y[-1]):
             raise ValueError(f"{self.source}: lateral shift {float(np.max(np.abs(y))):.6g} m outside the table "
