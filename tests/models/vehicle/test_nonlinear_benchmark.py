@@ -145,3 +145,65 @@ def test_dead_band_flange_spring() -> None:
     y = np.array([-0.012, -0.0091, -0.005, 0.0, 0.0091, 0.010])
     expected = np.array([14.6e6 * 0.0029, 0.0, 0.0, 0.0, 0.0, -14.6e6 * 0.0009])
     assert np.allclose(spring.force(y), expected, rtol=1e-12, atol=1e-6)
+
+
+# --- end to end: saturated creep and a dead-band flange, ramp and path following -------------------------------
+MU, DELTA, K0 = 0.15, 0.0091, 14.6e6   # friction, flange clearance, flange stiffness (recalled, see the file)
+RAMP = np.arange(44.0, 40.4, -0.5)     # m/s, step 0.5 m/s
+
+
+@pytest.fixture(scope="module")
+def nonlinear_bogie(vehicle):
+    from railopt.models.vehicle.nonlinear import nonlinear_vehicle
+    from railopt.models.vehicle.wheelset_forces import ConicalGeometry, WheelsetForces
+
+    wr = vehicle.wheel_rail()
+    forces = WheelsetForces(ConicalGeometry.from_wheel_rail(wr), wr.creep, wr.axle_load,
+                            SaturatedCreepLaw(mu=MU, load_scaling=False, spin_moment="linear"), plane="track",
+                            flange=FlangeSpring(DELTA, K0))
+    return nonlinear_vehicle(vehicle, forces)
+
+
+@pytest.mark.slow
+def test_subcritical_hopf_ramp_and_shooting(vehicle, nonlinear_bogie) -> None:
+    """Hard loss of stability (as published for the Cooperrider bogie): a stable hunting cycle lives below the
+    linear critical speed.  The descending ramp (time integration with the state carried
+    over) loses it between 41.5 and 41.0 m/s, 1 m/s and more below the linear critical speed 42.52 m/s; shooting
+    on the Poincaré section (Newton with the variational equations, a second method) converges the cycle at
+    41.5 m/s from the ramp's state, stable, with the ramp's amplitude and frequency."""
+    from railopt.models.bifurcation import (
+        Dwell,
+        IntegrationSettings,
+        PoincareSection,
+        ShootingOptions,
+        find_periodic_orbit,
+        speed_ramp,
+    )
+
+    model = nonlinear_bogie
+    linear = critical_speed(vehicle.lateral("rigid"), speed_range=(1.0, 200.0), tol=1e-10).speed
+    watched = model.index("wheelset1.v")
+    settings = IntegrationSettings(rtol=1e-6, atol=1e-9)
+    x0 = np.zeros(2 * model.n_dof)
+    x0[watched] = 0.0095  # on the flange: near the large cycle that exists above the Hopf speed
+    ramp = speed_ramp(model.rhs, x0, RAMP, Dwell(seconds=8.0), watched, sample_rate_hz=200.0, settings=settings)
+    low, high = ramp.fold_bracket
+    assert (low, high) == (41.0, 41.5)
+    assert high < linear - 1.0  # subcritical: the cycle outlives the straight running's loss of stability
+    speeds = list(ramp.speeds)
+    below = [v.classification for v, s in zip(ramp.verdicts, speeds, strict=True) if high <= s < linear]
+    assert below == ["steady"] * 3  # 42.5, 42.0, 41.5 m/s: stable cycles where straight running is stable too
+    last = ramp.verdicts[speeds.index(high)]
+    # shooting from the ramp's state at 41.5 m/s: the same cycle, stable
+    section = PoincareSection(model.index("wheelset1.v.rate"), 0.0, -1)
+    start = ramp.states[speeds.index(high)]
+    from scipy.integrate import solve_ivp
+
+    arrived = solve_ivp(lambda t, x: model.rhs(t, x, high), (0.0, 3.0 / last.frequency_hz), start,
+                        events=section.event(), **settings.options())
+    orbit = find_periodic_orbit(model.rhs, arrived.y_events[0][0], high, section, 1.0 / last.frequency_hz, watched,
+                                options=ShootingOptions(tol=1e-7), settings=settings,
+                                jacobian=lambda t, x, speed: model.jacobian(x, speed))
+    assert orbit.converged and orbit.stable
+    assert orbit.amplitude == pytest.approx(last.amplitude, rel=0.01)
+    assert orbit.frequency_hz == pytest.approx(last.frequency_hz, rel=0.01)
