@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import call, map_unordered
+from railopt.design.parallel import call, map_unordered, resolve, shipping
 from railopt.design.runner import Runner
 from railopt.design.store import CampaignStore
 
@@ -27,7 +27,7 @@ class _CheckTask:
     x: np.ndarray
 
     def __call__(self) -> tuple[int, float, Mapping[str, Any]]:
-        value, payload = self.check(self.x)
+        value, payload = resolve(self.check)(self.x)  # shipped once per check (a handle inside a dask task)
         return self.start_id, float(value), dict(payload)
 
 
@@ -50,12 +50,14 @@ def check_designs(
     missing = [v for v in variables if v not in designs.columns]
     if missing:
         raise ValueError(f"designs: missing variable columns {missing}")
-    tasks = [_CheckTask(check, int(r["start_id"]), r[variables].to_numpy(dtype=float)) for _, r in designs.iterrows()]
     rows = []
-    for start_id, value, payload in map_unordered(call, tasks, client=client):
-        if store is not None:
-            store.add_check(start_id, name, value, payload)
-        rows.append({"start_id": start_id, "name": name, "value": value, **payload})
+    with shipping(client, check, "check") as shipped:  # the check (and its model) goes to the workers once
+        tasks = [_CheckTask(shipped, int(r["start_id"]), r[variables].to_numpy(dtype=float))
+                 for _, r in designs.iterrows()]
+        for start_id, value, payload in map_unordered(call, tasks, client=client):
+            if store is not None:
+                store.add_check(start_id, name, value, payload)
+            rows.append({"start_id": start_id, "name": name, "value": value, **payload})
     return pd.DataFrame(rows).sort_values("start_id", ignore_index=True) if rows else pd.DataFrame(
         columns=["start_id", "name", "value"])
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import ProgressCallback, call, check_picklable, map_unordered
+from railopt.design.parallel import ProgressCallback, call, check_picklable, map_unordered, resolve, shipping
 from railopt.design.problem import MinimaxProblem
 from railopt.design.runner import Runner
 from railopt.records import ArrayRecord
@@ -53,11 +53,11 @@ class _Row:
     xj_value: float
 
     def __call__(self) -> tuple[float, np.ndarray]:
-        out = []
+        fn, out = resolve(self.fn), []  # fn shipped once per grid (a handle inside a dask task)
         for v in self.xi:
             x = self.base.copy()
             x[self.i], x[self.j] = v, self.xj_value
-            out.append(self.fn(x))
+            out.append(fn(x))
         return self.xj_value, np.array(out, dtype=float)
 
 
@@ -93,8 +93,9 @@ def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], nam
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
     if client is not None:
         check_picklable(fn)  # named from fn's own fields (e.g. problem.functions), not the row task's
-    rows = dict(map_unordered(call, [_Row(fn, base, i, j, xi, float(v)) for v in xj], client=client,
-                              progress=progress))
+    with shipping(client, fn, "fn") as shipped:  # the problem goes to the workers once, not with every row
+        rows = dict(map_unordered(call, [_Row(shipped, base, i, j, xi, float(v)) for v in xj], client=client,
+                                  progress=progress))
     return np.array([rows[float(v)] for v in xj])
 
 

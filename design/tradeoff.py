@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import ProgressCallback, call, map_unordered
+from railopt.design.parallel import ProgressCallback, call, map_unordered, resolve, shipping
 from railopt.design.problem import MinimaxProblem
 from railopt.design.runner import Runner
 from railopt.design.solve import method_options, solve
@@ -51,7 +51,8 @@ class _SweepTask:
     options: dict[str, Any]
 
     def __call__(self) -> tuple[float, Any]:
-        return self.epsilon, solve(self.problem.with_epsilon(self.epsilon), self.x0, self.method, **self.options)
+        problem = resolve(self.problem)  # shipped once per sweep (a handle inside a dask task)
+        return self.epsilon, solve(problem.with_epsilon(self.epsilon), self.x0, self.method, **self.options)
 
 
 
@@ -80,11 +81,12 @@ def epsilon_sweep(
         raise ValueError("epsilons: need at least one finite value")
     method_options(method, options)
     starts = start_points(problem.space, n_starts, seed=seed, points=points)
-    tasks = [_SweepTask(problem, e, s.x0, method, dict(options or {})) for e in eps for s in starts]
     best: dict[float, Any] = {}
-    for e, r in map_unordered(call, tasks, client=client, progress=progress):
-        if r.feasible and np.isfinite(r.value) and (e not in best or r.value < best[e].value):
-            best[e] = r
+    with shipping(client, problem) as shipped:  # the problem goes to the workers once, not with every solve
+        tasks = [_SweepTask(shipped, e, s.x0, method, dict(options or {})) for e in eps for s in starts]
+        for e, r in map_unordered(call, tasks, client=client, progress=progress):
+            if r.feasible and np.isfinite(r.value) and (e not in best or r.value < best[e].value):
+                best[e] = r
     rows = []
     for e in eps:
         r = best.get(e)
