@@ -12,7 +12,6 @@ nothing is written anywhere.  Warnings about values that load but look wrong (un
 from __future__ import annotations
 
 import ast
-import functools
 import math
 import operator
 from collections.abc import Mapping
@@ -437,22 +436,15 @@ def _wheel_rail(t: WheelRailSchema | None, names: Mapping[str, float], path: str
         source=t.source)
 
 
-@functools.lru_cache(maxsize=32)
 def _profile_conicity(profiles: WheelRailSpec, r0: float, e0: float) -> float:
-    """The EN 15302 equivalent conicity of the ``[wheel_rail]`` profile pair at its ``conicity_amplitude`` (from a
-    0.1 mm rigid-contact table, about 1 s: kept per profile pair, placement and radius; a profile file is named
-    by its path — edit a file and load it in a new process)."""
-    from railopt.models.contact import WheelsetTrack, equivalent_conicity, load_profile, rigid_contact_table
+    """The EN 15302 equivalent conicity of the ``[wheel_rail]`` profile pair at its ``conicity_amplitude``, from
+    the pair's 0.1 mm rigid-contact table (:meth:`WheelRailSpec.table`, the one ``Vehicle.contact_table`` gives)."""
+    from railopt.models.contact import equivalent_conicity
 
     try:
-        track = WheelsetTrack.symmetric(load_profile(profiles.wheel_profile, "wheel"),
-                                        load_profile(profiles.rail_profile, "rail"), gauge=profiles.gauge,
-                                        flange_back_distance=profiles.flange_back, r0=r0,
-                                        inclination=profiles.inclination)
+        table = profiles.table(r0, max(0.012, 2.0 * profiles.conicity_amplitude))
     except ValueError as exc:
         raise ValueError(f"wheel_rail: the profiles cannot be placed on the track ({exc})") from None
-    reach = max(0.012, 2.0 * profiles.conicity_amplitude)
-    table = rigid_contact_table(track, np.linspace(-reach, reach, int(round(2.0 * reach / 1e-4)) + 1))
     try:
         return equivalent_conicity(table.y, table.delta_r, profiles.conicity_amplitude, r0=r0, e0=e0)
     except ValueError as exc:
@@ -467,6 +459,7 @@ def _contact(t: ContactSchema | None, names: Mapping[str, float],
         return None
     r0 = _num(t, "wheel_radius_m", names, "contact", positive=True)
     e0 = _num(t, "semi_gauge_m", names, "contact", positive=True)
+    source = "stated" if t.conicity is not None else "delta_r table" if t.delta_r_m is not None else "profiles"
     if t.conicity is not None:
         lam = _num(t, "conicity", names, "contact", lower=0.0)
     elif t.delta_r_m is None:
@@ -503,7 +496,7 @@ def _contact(t: ContactSchema | None, names: Mapping[str, float],
         shear_modulus=shear, theory=t.theory,
         rail_head_radius=_num(t, "rail_head_radius_m", names, "contact", positive=True),
         wheel_transverse_radius=_num(t, "wheel_transverse_radius_m", names, "contact", positive=True),
-        source=t.source,
+        source=t.source, conicity_source=source,
     )
 
 

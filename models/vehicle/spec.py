@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from railopt.models.vehicle.geometry import DOFS
 from railopt.models.vehicle.wheelrail import Creep
@@ -65,6 +68,7 @@ class ContactSpec:
     rail_head_radius: float
     wheel_transverse_radius: float
     source: str
+    conicity_source: str = "stated"  # "stated", "delta_r table", "profiles" ([wheel_rail]) or "parameter override"
 
     def __post_init__(self) -> None:
         if self.creep not in CREEP_MODES:
@@ -94,6 +98,34 @@ class WheelRailSpec:
     conicity_amplitude: float = 0.003
     friction_coefficient: float = 0.4
     source: str = "estimate"
+
+    def track(self, r0: float):
+        """The wheelset on its track: a :class:`~railopt.models.contact.WheelsetTrack` with both wheels the wheel
+        profile at rolling radius ``r0`` (m), both rails the rail profile inclined by ``inclination``.
+
+        Raises
+        ------
+        ValueError
+            The profiles cannot be placed (naming the field of :class:`~railopt.models.contact.WheelsetTrack`)."""
+        from railopt.models.contact import WheelsetTrack, load_profile
+
+        return WheelsetTrack.symmetric(load_profile(self.wheel_profile, "wheel"),
+                                       load_profile(self.rail_profile, "rail"), gauge=self.gauge,
+                                       flange_back_distance=self.flange_back, r0=r0, inclination=self.inclination)
+
+    def table(self, r0: float, y_max: float = 0.012, step: float = 1e-4):
+        """Rigid contact geometry of :meth:`track` over −y_max … y_max (m) in steps of ``step``: a
+        :class:`~railopt.models.contact.ContactTable`, computed once per pair, radius, range and step (about 1 s
+        for the default 241 shifts; a profile file is named by its path: edit it and load it in a new process)."""
+        return _contact_table(self, float(r0), float(y_max), float(step))
+
+
+@functools.lru_cache(maxsize=32)
+def _contact_table(profiles: WheelRailSpec, r0: float, y_max: float, step: float):
+    from railopt.models.contact import rigid_contact_table
+
+    n = int(round(2.0 * y_max / step)) + 1
+    return rigid_contact_table(profiles.track(r0), np.linspace(-y_max, y_max, n))
 
 
 @dataclass(frozen=True)

@@ -188,8 +188,10 @@ def contact_rows(vehicle: Vehicle) -> list[tuple[str, str]]:
     if c is None:
         return []
     w = vehicle.profiles
-    stated = "[contact] conicity" if w is None or not _from_profiles(vehicle) else (
-        f"[wheel_rail] profiles, EN 15302 at {w.conicity_amplitude * 1e3:g} mm")
+    stated = {"stated": "[contact] conicity", "delta_r table": "[contact] Δr table, EN 15302",
+              "parameter override": "a parameter override"}.get(c.conicity_source, "")
+    if c.conicity_source == "profiles":
+        stated = f"[wheel_rail] profiles, EN 15302 at {w.conicity_amplitude * 1e3:g} mm"
     rows = [("conicity of the linear model", f"{c.conicity:.4g} ({stated})")]
     if w is None:
         return rows
@@ -210,19 +212,6 @@ def contact_rows(vehicle: Vehicle) -> list[tuple[str, str]]:
     onset = table.y[positive & steep]
     rows.append(("flange contact from", f"y = {onset[0] * 1e3:.2f} mm" if onset.size else "beyond the table"))
     return rows
-
-
-def _from_profiles(vehicle: Vehicle) -> bool:
-    """Whether the linear conicity was derived from the profiles (no stated conicity or Δr table in the file)."""
-    from railopt.tomlfile import read_toml
-
-    if not vehicle.path or not vehicle.path.endswith(".toml"):
-        return False
-    try:
-        contact = read_toml(vehicle.path, "vehicle file").get("contact", {})
-    except (OSError, ValueError):
-        return False
-    return "conicity" not in contact and "delta_r_m" not in contact
 
 
 def main_validate_vehicle(path: str) -> tuple[str, int]:

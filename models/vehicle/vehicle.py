@@ -168,7 +168,8 @@ class Vehicle:
                     raise ValueError(f"{name}: creep coefficients are computed (creep = 'hertz'); set creep_factor")
                 coefficients = replace(c.coefficients, **{key: value})
                 return replace(self, contact=replace(c, coefficients=coefficients), _cache={})
-            return replace(self, contact=replace(c, **{CONTACT_NAMES[key]: value}), _cache={})
+            source = {"conicity_source": "parameter override"} if CONTACT_NAMES[key] == "conicity" else {}
+            return replace(self, contact=replace(c, **{CONTACT_NAMES[key]: value}, **source), _cache={})
         if self.track is not None and key in TRACK_NAMES:
             return replace(self, track=replace(self.track, **{TRACK_NAMES[key]: value}), _cache={})
         raise ValueError(self._unknown(name))
@@ -213,27 +214,18 @@ class Vehicle:
         ------
         ValueError
             The vehicle has no ``[wheel_rail]`` table, or the profiles cannot be placed (naming the field)."""
-        from railopt.models.contact import WheelsetTrack, load_profile
-
-        w = self.profiles
-        if w is None:
+        if self.profiles is None:
             raise ValueError(f"vehicle {self.name!r} has no [wheel_rail] table (wheel and rail profiles)")
         if self.contact is None:
             raise ValueError(f"vehicle {self.name!r}: [wheel_rail] needs the [contact] table's wheel_radius_m")
-        return WheelsetTrack.symmetric(load_profile(w.wheel_profile, "wheel"), load_profile(w.rail_profile, "rail"),
-                                       gauge=w.gauge, flange_back_distance=w.flange_back, r0=self.contact.r0,
-                                       inclination=w.inclination)
+        return self.profiles.track(self.contact.r0)
 
     def contact_table(self, y_max: float = 0.012, step: float = 1e-4):
         """Rigid contact geometry of the ``[wheel_rail]`` profiles over −y_max … y_max (m) in steps of ``step``:
-        a :class:`~railopt.models.contact.ContactTable` (cached per range and step)."""
-        from railopt.models.contact import rigid_contact_table
-
-        key = ("contact_table", float(y_max), float(step))
-        if key not in self._cache:
-            n = int(round(2.0 * y_max / step)) + 1
-            self._cache[key] = rigid_contact_table(self.contact_track(), np.linspace(-y_max, y_max, n))
-        return self._cache[key]
+        a :class:`~railopt.models.contact.ContactTable` (:meth:`WheelRailSpec.table`, computed once per profile pair,
+        radius, range and step: the table the loader took the conicity from when the file states none)."""
+        self.contact_track()  # the errors naming what is missing
+        return self.profiles.table(self.contact.r0, y_max, step)
 
     def lumped_track(self) -> LumpedTrack:
         """Per-rail lumped track (4.33)–(4.39), roll terms (4.49) with ℓ18 = 2 e0."""

@@ -131,3 +131,13 @@ def test_summary_says_when_the_conicity_comes_from_the_profiles(tmp_path):
     v = load_vehicle(_coach(tmp_path, 'wheel_profile = "s1002"\nrail_profile = "60e1"\ninclination = "1/40"\n'))
     rows = dict(vehicle_summary(v).contact)
     assert rows["conicity of the linear model"] == f"{v.contact.conicity:.4g} ([wheel_rail] profiles, EN 15302 at 3 mm)"
+
+
+def test_a_conicity_override_is_named_as_such(tmp_path):
+    from railopt.models.vehicle.summary import contact_rows
+
+    v = load_vehicle(_coach(tmp_path, 'wheel_profile = "s1002"\nrail_profile = "60e1"\ninclination = "1/40"\n'))
+    assert v.contact.conicity_source == "profiles"
+    override = v.with_parameters({"conicity": 0.2})
+    assert override.contact.conicity == 0.2 and override.contact.conicity_source == "parameter override"
+    assert dict(contact_rows(override))["conicity of the linear model"] == "0.2 (a parameter override)"
