@@ -31,11 +31,13 @@ from railopt.studies.catalog import (
 )
 from railopt.studies.catalog.views import stability_view, vehicle_view
 from railopt.studies.config import StrictModel, not_one_of
+from railopt.studies.output.figures import vehicle_label
 
 __all__ = [
     "VEHICLE", "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family",
-    "load", "model_vehicles", "physical_limits", "readable_aliases", "tracks_of", "vehicle_forced_model",
-    "vehicle_forced_setup", "vehicle_lateral_setup", "vehicle_setup", "vehicle_title", "vehicle_warnings",
+    "load", "model_vehicle_file", "model_vehicles", "physical_limits", "readable_aliases", "tracks_of",
+    "vehicle_forced_model", "vehicle_forced_setup", "vehicle_lateral_setup", "vehicle_setup", "vehicle_title",
+    "vehicle_warnings",
 ]
 
 VEHICLE = ("a bundled vehicle name (sd40-2, manchester-coach, single-wheelset) or a vehicle file path (relative "
@@ -87,14 +89,20 @@ def _vehicles(sources: tuple[tuple[str, str, int], ...], cwd: str) -> tuple:
     return tuple(out)
 
 
+def model_vehicle_file(models: Sequence, model: str) -> str | None:
+    """The file name of the model's vehicle, ``"sd40-2.toml"`` (None for a model without a vehicle)."""
+    v = model_vehicles(models).get(model)
+    return None if v is None else Path(v["vehicle_file"].removesuffix(" (bundled)")).name
+
+
 def vehicle_title(models: Sequence, model: str, text: str) -> str:
-    """A figure title naming the model's vehicle and file: ``"sd40-2 (sd40-2.toml): <text>"``, or for a model
-    labelled other than its vehicle ``"coach_a: manchester-coach (coach.toml): <text>"``; ``"<model>: <text>"``
-    for a model without a vehicle."""
+    """A figure title naming the model's vehicle and file (:func:`~railopt.studies.output.figures.vehicle_label`):
+    ``"sd40-2 (sd40-2.toml): <text>"``, or for a model labelled other than its vehicle
+    ``"coach_a: manchester-coach (coach.toml): <text>"``; ``"<model>: <text>"`` for a model without a vehicle."""
     v = model_vehicles(models).get(model)
     if v is None:
         return f"{model}: {text}"
-    label = f"{v['vehicle']} ({Path(v['vehicle_file'].removesuffix(' (bundled)')).name})"
+    label = vehicle_label(v["vehicle"], model_vehicle_file(models, model))
     return f"{label}: {text}" if model == v["vehicle"] else f"{model}: {label}: {text}"
 
 

@@ -332,11 +332,11 @@ def _track_effect_sentences(effect: pd.DataFrame, sens: pd.DataFrame,
     lines = []
     for _, r in effect.iterrows():
         if not (np.isfinite(r["rigid_m_s"]) and np.isfinite(r["flexible_m_s"])):
-            words = {True: stable}
-            rigid = words.get(bool(np.isinf(r["rigid_m_s"])), f"{r['rigid_m_s']:.4g} m/s")
-            flexible = words.get(bool(np.isinf(r["flexible_m_s"])), f"{r['flexible_m_s']:.4g} m/s")
-            lines.append(f"- `{r['flexible']}`: critical speed on flexible track {flexible}, on rigid track "
-                         f"(`{r['rigid']}`) {rigid}: no change can be given.")
+            def shown(v: float) -> str:
+                return stable if np.isinf(v) else f"{v:.4g} m/s"
+
+            lines.append(f"- `{r['flexible']}`: critical speed on flexible track {shown(r['flexible_m_s'])}, on "
+                         f"rigid track (`{r['rigid']}`) {shown(r['rigid_m_s'])}: no change can be given.")
             continue
         verb = "raises" if r["change_m_s"] > 0 else "lowers"
         text = (f"- `{r['flexible']}`: the flexible track {verb} the critical speed by "

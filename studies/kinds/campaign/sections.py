@@ -5,7 +5,6 @@ surfaces) in the measure its objective minimised, and the vehicle each model is 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -16,8 +15,8 @@ from railopt.models.units import RAD_PER_HZ as HZ
 from railopt.models.units import m_to_in
 from railopt.studies.adapter import objective_value, response_target, rms_target
 from railopt.studies.catalog import ModelSetup
+from railopt.studies.catalog.vehicle import model_vehicle_file, vehicle_title
 from railopt.studies.catalog.vehicle import model_vehicles as catalog_model_vehicles
-from railopt.studies.catalog.vehicle import vehicle_title
 from railopt.studies.kinds.campaign.config import CampaignStudyConfig
 from railopt.studies.kinds.campaign.problems import (
     MEASURES,
@@ -223,9 +222,8 @@ def _frf_panels(cfg: CampaignStudyConfig, setups: dict[str, ModelSetup], compari
             curves.append((f"{label} ({rms}peak {r['true_peak']:.6g})", f_hz,
                            np.abs(setup.family.at(p).frf(frequencies_hz=f_hz, output=target.output)),
                            r["objective"]))
-        v = model_vehicles(cfg).get(model)
-        title = (f"{setup.description} ({Path(v['vehicle_file'].removesuffix(' (bundled)')).name})" if v
-                 else f"{model}: {setup.description}")
+        file = model_vehicle_file(cfg.models, model)  # the description names the vehicle, the file goes beside it
+        title = f"{setup.description} ({file})" if file else f"{model}: {setup.description}"
         panels.append(FrfPanel.build(title, setup.axis_label(target.output), curves))
     return panels
 
