@@ -539,6 +539,12 @@ def _key(name: str) -> str:
     return ALIASES.get(k, k)
 
 
+def is_profile_name(name: str) -> bool:
+    """Whether ``name`` is a catalogue name or alias (:data:`PROFILE_NAMES`), spelled as :func:`load_profile`
+    accepts it (case and ``-``/``_``/space insensitive)."""
+    return _key(name) in CATALOGUE
+
+
 @functools.lru_cache(maxsize=32)
 def _cached(key: str) -> Profile:
     return CATALOGUE[key][0]()
@@ -573,5 +579,6 @@ def load_profile(name_or_path: str | Path, kind: str | None = None, **kw: object
 
 __all__ = [
     "ALIASES", "CATALOGUE", "DATA_DIR", "PROFILE_NAMES", "RAIL_60E1", "S1002_BREAKPOINTS_MM", "Profile", "RailHeadArcs",
-    "incline", "load_profile", "rail_60e1", "read_profile_csv", "read_simpack_profile", "s1002", "s1002_depth_mm",
+    "incline", "is_profile_name", "load_profile", "rail_60e1", "read_profile_csv", "read_simpack_profile", "s1002",
+    "s1002_depth_mm",
 ]

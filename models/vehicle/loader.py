@@ -408,12 +408,12 @@ def _wheel_rail(t: WheelRailSchema | None, names: Mapping[str, float], path: str
     if t is None:
         return None
     from railopt.models.contact import PROFILE_NAMES, load_profile
-    from railopt.models.contact.profiles import _key
+    from railopt.models.contact.profiles import is_profile_name
 
     sources = {}
     for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail")):
         raw = getattr(t, key)
-        if _key(raw) in {_key(n) for n in PROFILE_NAMES}:
+        if is_profile_name(raw):
             source = raw
         else:
             where = Path(raw) if Path(raw).is_absolute() else Path(path).resolve().parent / raw
