@@ -19,6 +19,8 @@
    model (6 delayed axle inputs) against the floor.
 7. Stability constraints with gradients against one eig(G) per speed; the random-response RMS by quadrature
    against the modal Lyapunov covariance at equal accuracy.
+8. The nonlinear hunting analysis (:mod:`.bench_nonlinear`): seconds per simulated second of the nonlinear coach
+   and single wheelset on S1002/60E1, and per bifurcation diagram, against the certified linear critical speed.
 
 Timings are medians of repeated runs (``time.perf_counter``); results go to ``bench.csv`` and ``bench.md`` in
 ``--out`` (default ``runs/benchmarks/``; the committed rows: ``railopt bench --out results/benchmarks``), the full
@@ -44,6 +46,7 @@ from railopt.models.tmd import nishihara_asami
 from railopt.models.units import INCH, RAD_PER_HZ
 from railopt.models.vehicle import load_vehicle
 from railopt.studies.adapter import response_target
+from railopt.studies.bench_nonlinear import nonlinear_rows
 from railopt.studies.bench_stability import critical_speed_rows
 from railopt.studies.config import load_study
 from railopt.studies.kinds.campaign import campaign_problem
@@ -591,6 +594,7 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
 
     # 5. critical speed: certified (bialternate pencil) vs the sampled search and a dense scan ------------
     rows += critical_speed_rows()
+    rows += nonlinear_rows(quick)
 
     rows.append(_vehicle_summary_row())
 

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
 __all__ = [
     "CampaignSettings",
     "ConstraintSpec",
+    "NonlinearHuntingSpec",
     "ObjectiveSpec",
     "OutputSpec",
     "SolverOptions",
@@ -218,3 +219,50 @@ class StabilitySpec(FiniteModel):
         speeds``) to ``required``."""
         low = min(self.lowest_speed_m_s or required / self.speeds, required)
         return tuple(float(v) for v in np.linspace(low, required, self.speeds))
+
+
+class NonlinearHuntingSpec(FiniteModel):
+    """``[nonlinear_hunting]``: the nonlinear critical-speed analysis on the vehicle's wheel and rail profiles.
+
+    The settings of :class:`railopt.models.vehicle.hunting.HuntingAnalysis` in file units (m/s, mm): a coarse
+    descending ramp from ``top_speed_m_s`` (default 1.2 × the linear critical speed) in ``step_m_s`` steps (default
+    5 % of the top), a fine ramp in ``fine_step_m_s`` steps (default 1 %) through the speed where the coarse ramp
+    lost its cycle, each speed held for ``dwell_wavelengths`` kinematic wavelengths, started with the leading
+    wheelset ``initial_amplitude_mm`` off centre; with ``continuation`` the cycle is then followed by shooting and
+    pseudo-arclength continuation through its fold (minutes per vehicle; without it the answer is the ramp's
+    bracket).  ``window_m`` is the EN 14363 sliding-RMS window of the ΣY indicator.
+    """
+
+    top_speed_m_s: float | None = Field(None, gt=0, lt=1000)
+    lowest_speed_m_s: float = Field(5.0, gt=0, lt=1000)
+    step_m_s: float | None = Field(None, gt=0, lt=100)
+    fine_step_m_s: float | None = Field(None, gt=0, lt=100)
+    dwell_wavelengths: float = Field(20.0, gt=0, le=1000)
+    initial_amplitude_mm: float = Field(3.0, gt=0, le=20, description="leading wheelset's lateral offset at the "
+                                        "start, mm")
+    friction_coefficient: float | None = Field(None, gt=0, le=1, description="default: the vehicle file's "
+                                               "[wheel_rail] friction_coefficient")
+    rtol: float = Field(1e-6, gt=0, le=1e-3)
+    continuation: bool = True
+    max_points: int = Field(150, ge=2, le=10_000, strict=True)
+    points_after_fold: int | None = Field(None, ge=1, le=10_000, strict=True, description=(
+        "stop the continuation this many points past the fold (default: follow the unstable branch)"))
+    window_m: float = Field(100.0, gt=0, le=10_000, description="sliding-RMS window of ΣY (EN 14363), m")
+
+    @model_validator(mode="after")
+    def _speeds(self) -> NonlinearHuntingSpec:
+        if self.top_speed_m_s is not None and not self.top_speed_m_s > self.lowest_speed_m_s:
+            raise ValueError(f"top_speed_m_s: {self.top_speed_m_s:g} m/s is not above lowest_speed_m_s "
+                             f"{self.lowest_speed_m_s:g} m/s (a descending ramp)")
+        return self
+
+    def analysis(self, search: tuple[float, float] = (1.0, 150.0)) -> Any:
+        """The :class:`~railopt.models.vehicle.hunting.HuntingAnalysis` of these settings (SI units)."""
+        from railopt.models.vehicle.hunting import HuntingAnalysis
+
+        return HuntingAnalysis(top_speed=self.top_speed_m_s, lowest_speed=self.lowest_speed_m_s, step=self.step_m_s,
+                               fine_step=self.fine_step_m_s, dwell_wavelengths=self.dwell_wavelengths,
+                               initial_amplitude=self.initial_amplitude_mm * 1e-3,
+                               friction_coefficient=self.friction_coefficient, search=tuple(search),
+                               rtol=self.rtol, atol=self.rtol * 1e-3, continuation=self.continuation,
+                               max_points=self.max_points, points_after_fold=self.points_after_fold)

@@ -7,7 +7,7 @@ frequencies in Hz, periods in s.  Method, tolerances and limits: ``docs/nonlinea
 Public API
 ----------
 * :class:`IntegrationSettings` (:mod:`.integration`) — solve_ivp method and tolerances (LSODA, rtol 1e-10,
-  atol 1e-12 by default).
+  atol 1e-12 by default); :class:`ModelLimit`, raised by a right-hand side whose model stops applying.
 * :class:`PoincareSection` (:mod:`.section`) — hyperplane x[index] = value crossed in ``direction``.
 * :func:`detect_limit_cycle`, :class:`CycleTolerances`, :class:`CycleVerdict` (:mod:`.limit_cycle`) —
   amplitude, frequency and growth per cycle of a sampled coordinate; steady / decaying / growing / rest.
@@ -24,7 +24,7 @@ Public API
 from railopt.models.bifurcation.continuation import ContinuationOptions, continue_periodic_orbit
 from railopt.models.bifurcation.critical_speed import bifurcation_diagram
 from railopt.models.bifurcation.diagram import BifurcationDiagram, Fold, NonlinearCriticalSpeed
-from railopt.models.bifurcation.integration import IntegrationSettings
+from railopt.models.bifurcation.integration import IntegrationSettings, ModelLimit
 from railopt.models.bifurcation.limit_cycle import CycleTolerances, CycleVerdict, detect_limit_cycle
 from railopt.models.bifurcation.periodic_orbit import PeriodicOrbit, ShootingOptions, find_periodic_orbit
 from railopt.models.bifurcation.ramp import Dwell, RampResult, speed_ramp
@@ -38,6 +38,7 @@ __all__ = [
     "Dwell",
     "Fold",
     "IntegrationSettings",
+    "ModelLimit",
     "NonlinearCriticalSpeed",
     "PeriodicOrbit",
     "PoincareSection",

@@ -61,6 +61,10 @@ class ContinuationOptions:
         Newton steps of one corrector (default 8).
     max_turn_deg : float
         Largest angle between successive tangents (default 20°).
+    points_after_fold : int or None
+        Stop once this many points lie beyond the first fold (None: go on until another rule fires).  A
+        nonlinear critical speed needs only the fold; the unstable branch beyond it (the basin's edge) costs the
+        rest.
     """
 
     step: float = 0.02
@@ -71,6 +75,7 @@ class ContinuationOptions:
     speed_scale: float = 1.0
     corrector_iterations: int = 8
     max_turn_deg: float = 20.0
+    points_after_fold: int | None = None
 
     def __post_init__(self) -> None:
         for name in ("step", "min_step", "max_step", "state_scale", "speed_scale", "max_turn_deg"):
@@ -82,6 +87,9 @@ class ContinuationOptions:
             value = getattr(self, name)
             if not (isinstance(value, int) and value >= 2):
                 raise ValueError(f"{name}: must be an int >= 2, got {value!r}")
+        if self.points_after_fold is not None and not (isinstance(self.points_after_fold, int)
+                                                       and self.points_after_fold >= 1):
+            raise ValueError(f"points_after_fold: must be an int >= 1 or None, got {self.points_after_fold!r}")
 
 
 @dataclass
@@ -253,6 +261,10 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         points.append(new)
         amplitudes.append(amplitude)
         branch_ids.append(len(folds))
+        beyond = sum(1 for b in branch_ids if b >= 1)
+        if options.points_after_fold is not None and beyond >= options.points_after_fold:
+            reason = f"{beyond} points beyond the fold at {folds[0].speed:.6g} m/s (points_after_fold)"
+            break
         if aimed_at_edge:
             if min(speed - low, high - speed) <= EDGE_TOL * options.speed_scale:
                 reason = (f"reached the edge of the speed range [{low:g}, {high:g}] m/s "

@@ -27,6 +27,15 @@ Jacobian = Callable[[float, np.ndarray, float], np.ndarray]
 """``jacobian(t, x, speed) -> ∂f/∂x`` of shape (n, n)."""
 
 
+class ModelLimit(ValueError):
+    """Raised by a right-hand side whose model stops applying in the state reached (e.g. a wheel lifts off its rail).
+
+    Not an input error: the trajectory left the region the model describes.  :func:`~.ramp.speed_ramp` records
+    it as the verdict ``"model_limit"`` at that speed (the message as the reason) and starts the next speed from
+    the ramp's initial state; everything else lets it propagate.
+    """
+
+
 @dataclass(frozen=True)
 class IntegrationSettings:
     """Solver and tolerances handed to :func:`scipy.integrate.solve_ivp` for every trajectory.
@@ -102,6 +111,7 @@ __all__ = [
     "METHODS",
     "IntegrationSettings",
     "Jacobian",
+    "ModelLimit",
     "RightHandSide",
     "check_state",
     "speed_derivative",

@@ -10,6 +10,10 @@ call the speed just above the fold ``"decaying"`` (transient not yet settled) or
 
 The dwell is set in seconds or in wavelengths (n wavelengths of length L take n L / V seconds at speed V, the
 usual ramp setting for hunting, where L is the kinematic or the expected hunting wavelength).
+
+A right-hand side that raises :class:`~.integration.ModelLimit` (its model stops applying, e.g. a wheel lifts
+off the rail in flange contact) gives the verdict ``"model_limit"`` at that speed, with the message as the reason;
+the next speed starts again from ``x0``.  Such a speed never ends a fold bracket.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
-from railopt.models.bifurcation.integration import IntegrationSettings, RightHandSide, check_state
+from railopt.models.bifurcation.integration import IntegrationSettings, ModelLimit, RightHandSide, check_state
 from railopt.models.bifurcation.limit_cycle import (
     Coordinate,
     CycleTolerances,
@@ -151,6 +155,7 @@ def speed_ramp(rhs: RightHandSide, x0: np.ndarray, speeds: np.ndarray, dwell: Dw
     """
     settings = settings or IntegrationSettings()
     x = check_state(x0)
+    start_state = x.copy()
     speeds = np.asarray(speeds, dtype=float)
     if speeds.ndim != 1 or speeds.size < 2 or not np.all(np.isfinite(speeds)):
         raise ValueError(f"speeds: need a finite 1-D array of at least 2 speeds, got shape {speeds.shape}")
@@ -167,11 +172,18 @@ def speed_ramp(rhs: RightHandSide, x0: np.ndarray, speeds: np.ndarray, dwell: Dw
         start = t0 + (1.0 - window) * duration
         count = max(int(math.ceil(window * duration * sample_rate_hz)) + 1, 5)
         samples = np.linspace(start, t0 + duration, count)
-        sol = solve_ivp(rhs, (t0, t0 + duration), x, t_eval=samples, args=(float(speed),), **settings.options())
-        if sol.status != 0:
-            raise ValueError(f"rhs: integration failed at speed {speed} m/s: {sol.message}")
-        verdict = detect_limit_cycle(sol.t, watched_values(sol.y, coordinate), tolerances)
-        x = sol.y[:, -1].copy()
+        try:
+            sol = solve_ivp(rhs, (t0, t0 + duration), x, t_eval=samples, args=(float(speed),),
+                            **settings.options())
+        except ModelLimit as limit:
+            verdict = CycleVerdict("model_limit", math.nan, math.nan, math.nan, math.nan, 0,
+                                   f"the model stopped applying: {limit}")
+            x = start_state.copy()  # the next speed starts afresh from the ramp's initial state
+        else:
+            if sol.status != 0:
+                raise ValueError(f"rhs: integration failed at speed {speed} m/s: {sol.message}")
+            verdict = detect_limit_cycle(sol.t, watched_values(sol.y, coordinate), tolerances)
+            x = sol.y[:, -1].copy()
         t0 += duration
         done_speeds.append(float(speed))
         verdicts.append(verdict)

@@ -247,6 +247,12 @@ class ContactTable:
         """Indices i where either contact jumps between y[i−1] and y[i], or either side has two-point contact."""
         return np.nonzero(self.jump_left | self.jump_right | self.two_point_left | self.two_point_right)[0]
 
+    def flange_onset(self, angle_deg: float = 45.0) -> float:
+        """The smallest shift y > 0 (m) at which the left wheel's contact angle exceeds ``angle_deg``: where the
+        contact moves onto the flange (the flangeway clearance the wheelset can use); inf beyond the table."""
+        steep = (self.y > 0) & (np.abs(self.contact_angle_left) > np.radians(angle_deg))
+        return float(self.y[steep][0]) if np.any(steep) else math.inf
+
     def at(self, y: np.ndarray | float, kind: str = "linear") -> ContactTable:
         """The table interpolated at ``y`` (m, within [y[0], y[-1]]).
 

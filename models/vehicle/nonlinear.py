@@ -29,7 +29,12 @@ import numpy as np
 
 from railopt.models.vehicle.assembly import assemble
 from railopt.models.vehicle.geometry import LATERAL_DOFS, VERTICAL_DOFS, coordinate, split
-from railopt.models.vehicle.wheelset_forces import FORCE_ROWS, WheelsetForces, linear_model_forces
+from railopt.models.vehicle.wheelset_forces import (
+    FORCE_ROWS,
+    WheelsetContactState,
+    WheelsetForces,
+    linear_model_forces,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from railopt.models.vehicle.vehicle import Vehicle
@@ -112,6 +117,12 @@ class NonlinearVehicle:
         """Generalised contact forces (5, K) on the wheelsets' u, v, α, β, γ rows at state x, speed (m/s)."""
         z, zd = self.wheelset_states(x)
         return self.forces.generalized_forces(z[1], z[4], zd[1], zd[2], zd[4], zd[0], zd[3], speed)
+
+    def contact_state(self, x: np.ndarray, speed: float) -> WheelsetContactState:
+        """Everything the wheel/rail forces compute at state x and speed (m/s): creepages, creep and normal forces,
+        the wheels' vertical Q and lateral Y (N, arrays (2, K): left, right wheel of each of ``wheelsets``)."""
+        z, zd = self.wheelset_states(x)
+        return self.forces.evaluate(z[1], z[4], zd[1], zd[2], zd[4], zd[0], zd[3], speed)
 
     def rhs(self, t: float, x: np.ndarray, speed: float) -> np.ndarray:
         """ẋ at time t (unused: autonomous) and forward speed ``speed`` (m/s), shape (2n,)."""

@@ -207,10 +207,8 @@ def contact_rows(vehicle: Vehicle) -> list[tuple[str, str]]:
         except ValueError:
             values.append(f"{a:g} mm: –")
     rows.append(("tan γe of the profiles", ", ".join(values)))
-    steep = np.abs(table.contact_angle_left) > np.radians(45.0)
-    positive = table.y > 0
-    onset = table.y[positive & steep]
-    rows.append(("flange contact from", f"y = {onset[0] * 1e3:.2f} mm" if onset.size else "beyond the table"))
+    onset = table.flange_onset()
+    rows.append(("flange contact from", f"y = {onset * 1e3:.2f} mm" if np.isfinite(onset) else "beyond the table"))
     return rows
 
 

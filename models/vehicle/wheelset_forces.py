@@ -63,6 +63,7 @@ from typing import Literal, Protocol, runtime_checkable
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
+from railopt.models.bifurcation.integration import ModelLimit
 from railopt.models.contact.saturation import SPIN_MOMENT_CHOICES, she_force_ratio
 from railopt.models.validation import number
 from railopt.models.vehicle.wheelrail import Creep, WheelRail
@@ -275,7 +276,7 @@ class SaturatedCreepLaw:
     def __call__(self, creep: Creep, xi_x, xi_y, xi_sp, N, N0):
         N = np.asarray(N, dtype=float)
         if np.any(N <= 0.0):
-            raise ValueError(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0): the wheelset "
+            raise WheelLift(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0): the wheelset "
                              "derails in this model; the rigid contact no longer applies")
         k = N / N0 if self.load_scaling else np.ones_like(N)
         c = np.cbrt(k)
@@ -318,6 +319,16 @@ class FlangeSpring:
 
 # ---------------------------------------------------------------------------------------------------- the forces
 Plane = Literal["contact", "track"]
+
+
+class WheelLift(ModelLimit):
+    """A wheel's normal load reached zero: the rigid quasi-static contact no longer applies (a ValueError).
+
+    With the normal loads balancing only the static axle load W, a single flange contact steeper than
+    atan(a/h) (≈ 58° for a = 0.75 m, h = 0.46 m) has its line of action below the wheelset centre, so only a
+    negative load on the other wheel balances the roll moment (Q_r = N (cos δ − (h/a) sin δ) of the quasi-static
+    balance).  The speed ramp records it as the verdict ``"model_limit"``.
+    """
 
 
 @dataclass(frozen=True)
@@ -444,7 +455,7 @@ class WheelsetForces:
             N = N_new
             if np.any(N <= 0.0):
                 i = int(np.argmin(np.min(N, axis=0)))
-                raise ValueError(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0) at y = "
+                raise WheelLift(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0) at y = "
                                  f"{y[i]:.6g} m: the rigid contact no longer applies (derailment)")
             if not self.creep_law.load_dependent:
                 break
@@ -534,6 +545,7 @@ __all__ = [
     "LinearCreepLaw",
     "SaturatedCreepLaw",
     "TabulatedGeometry",
+    "WheelLift",
     "WheelsetContactState",
     "WheelsetForces",
     "linear_model_forces",

@@ -6,6 +6,7 @@ real part of the roots, :class:`HuntingCheck` the critical speed and least dampi
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Protocol
@@ -16,7 +17,8 @@ from railopt.models import ParametricSystem
 from railopt.models.stability import critical_speed, spectral_abscissa
 from railopt.models.stability_map import least_damping_ratio, stability_map
 
-__all__ = ["CRITERION_TOL", "MEMO_SIZE", "AbscissaCheck", "Check", "CheckResult", "HuntingCheck"]
+__all__ = ["CRITERION_TOL", "MEMO_SIZE", "AbscissaCheck", "Check", "CheckResult", "HuntingCheck",
+           "NonlinearHuntingCheck"]
 
 MEMO_SIZE = 256  # designs a hunting check remembers
 CRITERION_TOL = 1e-6  # 1/s and damping ratio: the constraint rows' feasibility tolerance, allowed by the check too
@@ -136,3 +138,67 @@ class HuntingCheck:
         data.update(required_speed_m_s=self.max_speed, sigma_min=self.sigma_min, zeta_min=self.zeta_min)
         return CheckResult(speed, {"stable": bool(all(holds) and all(certified)), "certified": bool(all(certified))},
                            data)
+
+
+@dataclass(frozen=True)
+class NonlinearHuntingCheck:
+    """The nonlinear critical speed of a design on the vehicle's wheel and rail profiles (issue 26 item 6).
+
+    Runs :func:`railopt.models.vehicle.hunting.nonlinear_hunting` on the vehicle with the design's values: a
+    descending speed ramp with the state carried over (coarse, then fine through the speed where the hunting cycle
+    is lost) and, with ``analysis.continuation``, shooting and pseudo-arclength continuation of the cycle through its
+    fold.  Value: the lowest speed at which a stable hunting cycle was found (m/s): the continuation's fold when the
+    ramp confirms it, else the lowest ramp speed with a steady cycle; inf when none was seen.  Flag
+    ``nonlinear_stable``: no stable hunting cycle at or below ``max_speed`` (the required speed) — the confirmed
+    fold is above it, or the ramp lost the cycle at a speed at or above it, or no speed of the ramp (from its top
+    speed down) held a cycle; a bracket that straddles the required speed without a confirmed fold is not a pass.
+    Data: the lowest hunting speed (inf: none from the ramp's top speed down), the ramp's top speed and bracket, the
+    fold and whether it is confirmed (1/0), the linear critical speed, the gap linear − lowest hunting speed (m/s)
+    and the required speed.  Minutes per design:
+    the campaign runs it on each distinct optimum as a task.  ``parameters`` names p; the vehicle takes them by
+    name (:meth:`~railopt.models.vehicle.Vehicle.with_parameters`).
+    """
+
+    vehicle: Any
+    parameters: tuple[str, ...]
+    max_speed: float
+    analysis: Any = None
+    expensive: ClassVar[bool] = True  # not run by ``railopt validate``'s warnings (minutes per design)
+    flag_names: ClassVar[tuple[str, ...]] = ("nonlinear_stable",)
+    _memo: dict = field(default_factory=dict, init=False, compare=False, repr=False)
+
+    def __getstate__(self) -> dict:
+        """Pickled (into a dask task) without the results it remembers."""
+        return {k: v for k, v in self.__dict__.items() if k != "_memo"}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state, _memo={})
+
+    def with_analysis(self, analysis: Any, max_speed: float | None = None) -> NonlinearHuntingCheck:
+        """The same check with a study's ``[nonlinear_hunting]`` settings (and required speed, m/s)."""
+        return replace(self, analysis=analysis, max_speed=float(max_speed if max_speed is not None
+                                                                 else self.max_speed))
+
+    def result(self, p: np.ndarray) -> Any:
+        """The full :class:`~railopt.models.vehicle.hunting.HuntingResult` of design p (remembered)."""
+        from railopt.models.vehicle.hunting import nonlinear_hunting
+
+        key = np.asarray(p, dtype=float).tobytes()
+        if key not in self._memo:
+            if len(self._memo) >= 16:
+                self._memo.clear()
+            values = dict(zip(self.parameters, np.asarray(p, dtype=float).tolist(), strict=True))
+            self._memo[key] = nonlinear_hunting(self.vehicle.with_parameters(values), self.analysis)
+        return self._memo[key]
+
+    def __call__(self, p: np.ndarray) -> CheckResult:
+        r = self.result(p)
+        low, high = r.bracket if r.bracket is not None else (float("nan"), float("nan"))
+        lowest = r.lowest_hunting_speed()
+        passes = r.passes(self.max_speed)
+        data = {"lowest_hunting_speed_m_s": lowest, "ramp_top_speed_m_s": float(r.ramp.speeds[0]),
+                "ramp_last_cycle_m_s": high, "ramp_lost_cycle_at_m_s": low, "fold_speed_m_s": r.critical.fold_speed,
+                "fold_confirmed": float(r.critical.confirmed), "linear_critical_speed_m_s": r.linear_critical_speed,
+                "hunting_gap_m_s": r.linear_critical_speed - lowest if math.isfinite(lowest) else math.nan,
+                "nonlinear_required_speed_m_s": self.max_speed}
+        return CheckResult(lowest, {"nonlinear_stable": passes is True}, data)

@@ -29,9 +29,11 @@ from railopt.studies.catalog import (
     PositiveInterval,
     register_model,
 )
+from railopt.studies.catalog.checks import NonlinearHuntingCheck
 from railopt.studies.catalog.views import stability_view, vehicle_view
 from railopt.studies.config import StrictModel, not_one_of
 from railopt.studies.output.figures import vehicle_label
+from railopt.studies.specs import NonlinearHuntingSpec
 
 __all__ = [
     "VEHICLE", "HuntingOptions", "IrregularityOptions", "VehicleForcedOptions", "VehicleOptions", "lateral_family",
@@ -223,7 +225,10 @@ def vehicle_setup(vehicle, family: ParametricSystem, description: str, tracks: S
         parameter_map=ParameterMap(names, family.values, aliases, limits=physical_limits(vehicle, names)),
         named_designs={"existing": existing},
         checks={"spectral_abscissa": AbscissaCheck(abscissa),
-                "hunting": HuntingCheck(stability, names, search, max_speed)},
+                "hunting": HuntingCheck(stability, names, search, max_speed),
+                **({"nonlinear_hunting": NonlinearHuntingCheck(vehicle, names, max_speed,
+                                                               NonlinearHuntingSpec().analysis(search))}
+                   if vehicle.profiles is not None else {})},
         stability=stability,
         other_tracks=other_tracks,
         description=description,

@@ -16,6 +16,7 @@ from railopt.models.bifurcation import (
     Dwell,
     Fold,
     IntegrationSettings,
+    ModelLimit,
     PoincareSection,
     RampResult,
     bifurcation_diagram,
@@ -104,6 +105,19 @@ def test_continuation_stops_at_the_edge_of_the_speed_range():
     assert high - upwards.speed.max() <= EDGE_TOL * V_REF
 
 
+def test_continuation_stops_a_given_number_of_points_past_the_fold():
+    """Normal form: fold at V = 25 m/s, r² = 1/2 there (closed form); 3 points past it and no more."""
+    start = find_periodic_orbit(normal_form, np.array([1.0, 0.0]), 28.0, SECTION, 1.0, 0)
+    diagram = continue_periodic_orbit(normal_form, start, SECTION, 0, speed_range=(20.0, 34.0),
+                                      options=ContinuationOptions(speed_scale=V_REF, points_after_fold=3))
+    assert "points beyond the fold" in diagram.stop_reason
+    assert int(np.sum(diagram.branch >= 1)) == 3 and len(diagram.folds) == 1
+    assert diagram.fold_speed == pytest.approx(25.0, abs=1e-8)
+    assert diagram.folds[0].amplitude == pytest.approx(math.sqrt(0.5), rel=1e-6)
+    with pytest.raises(ValueError, match="points_after_fold"):
+        ContinuationOptions(points_after_fold=0)
+
+
 def test_a_fold_outside_the_ramp_bracket_is_not_confirmed():
     verdict_steady = detect_limit_cycle(np.linspace(0, 10, 1001), np.sin(2 * math.pi * np.linspace(0, 10, 1001)))
     verdict_rest = detect_limit_cycle(np.linspace(0, 10, 1001), np.zeros(1001))
@@ -117,6 +131,36 @@ def test_a_fold_outside_the_ramp_bracket_is_not_confirmed():
     critical = diagram.nonlinear_critical_speed()
     assert not critical.confirmed and math.isnan(critical.speed) and "outside" in critical.reason
     assert critical.fold_speed == 25.0
+
+
+def test_a_model_limit_is_a_verdict_and_the_next_speed_starts_afresh():
+    """The normal form's model 'stops applying' beyond r = 1.1 (a stand-in for a wheel lifting in flange contact):
+    at 36 m/s the stable cycle r² = (1 + √(1 + 4μ))/2, μ = (V − 30)/20, has r = 1.114 > 1.1, so the ramp records
+    a model limit; 34 m/s starts again from x0 and settles on its cycle r = 1.0817 (closed form); the fold of the
+    closed form, 25 m/s, is still bracketed."""
+    def limited(t: float, x: np.ndarray, speed: float) -> np.ndarray:
+        if math.hypot(x[0], x[1]) > 1.1:
+            raise ModelLimit(f"r = {math.hypot(x[0], x[1]):.4f} beyond 1.1")
+        return normal_form(t, x, speed)
+
+    ramp = speed_ramp(limited, np.array([1.05, 0.0]), np.array([36.0, 34.0, 30.0, 27.0, 26.0, 24.0]),
+                      Dwell(seconds=40.0), 0, sample_rate_hz=40.0, settings=IntegrationSettings(rtol=1e-9))
+    kinds = [v.classification for v in ramp.verdicts]
+    assert kinds[0] == "model_limit" and "beyond 1.1" in ramp.verdicts[0].reason
+    assert math.isnan(ramp.verdicts[0].amplitude)
+    np.testing.assert_array_equal(ramp.states[0], [1.05, 0.0])  # what the next speed starts from
+    mu = (34.0 - V_C) / V_REF
+    assert kinds[1] == "steady"
+    assert ramp.verdicts[1].amplitude == pytest.approx(math.sqrt((1 + math.sqrt(1 + 4 * mu)) / 2), rel=1e-4)
+    assert ramp.fold_bracket == (24.0, 26.0)
+
+    def broken(t: float, x: np.ndarray, speed: float) -> np.ndarray:
+        if speed < 30:
+            raise ValueError("a bad input, not a model limit")
+        return normal_form(t, x, speed)
+
+    with pytest.raises(ValueError, match="bad input"):  # other errors are not swallowed
+        speed_ramp(broken, np.array([1.0, 0.0]), np.array([31.0, 29.0]), Dwell(seconds=1.0), 0, sample_rate_hz=40.0)
 
 
 def test_dwell_in_wavelengths_is_n_lambda_over_v():

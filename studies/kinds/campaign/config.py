@@ -17,6 +17,7 @@ from railopt.studies.config import FileName, FiniteModel, MethodName, StrictMode
 from railopt.studies.specs import (
     CampaignSettings,
     ConstraintSpec,
+    NonlinearHuntingSpec,
     ObjectiveSpec,
     OutputSpec,
     SolverOptions,
@@ -167,6 +168,7 @@ class CampaignStudyConfig(ModelsStudy):
     report: ReportSpec = ReportSpec()
     tradeoffs: list[TradeoffSpec] = Field(default_factory=list)
     surfaces: list[SurfaceSpec] = Field(default_factory=list)
+    nonlinear_hunting: NonlinearHuntingSpec | None = None
 
     @model_validator(mode="after")
     def _resolve(self) -> CampaignStudyConfig:
@@ -184,11 +186,19 @@ class CampaignStudyConfig(ModelsStudy):
         (each entry keeps its model, :meth:`ModelRef.setup`), the ``hunting`` check stating the ``[stability]``
         criterion of the study (σ_min, ζ_min, the lowest and the required speed, every track constrained), as the
         constraint rows do."""
-        key = "criterion " + ("none" if self.stability is None else self.stability.model_dump_json())
+        key = "criterion " + ("none" if self.stability is None else self.stability.model_dump_json()) + (
+            "" if self.nonlinear_hunting is None else self.nonlinear_hunting.model_dump_json())
         return {m.label: m.built(key, lambda m=m, i=i: self._with_criterion(m.setup(f"models[{i}]")))
                 for i, m in enumerate(self.models)}
 
     def _with_criterion(self, setup: ModelSetup) -> ModelSetup:
+        nonlinear = setup.checks.get("nonlinear_hunting")
+        if nonlinear is not None:  # the study's [nonlinear_hunting] settings and required speed
+            hunting = setup.checks["hunting"]
+            spec = self.nonlinear_hunting or NonlinearHuntingSpec()
+            required = self.stability.required(setup) if self.stability is not None else setup.required_speed
+            setup = replace(setup, checks={**setup.checks, "nonlinear_hunting": nonlinear.with_analysis(
+                spec.analysis(hunting.search), required)})
         if self.stability is None:
             return setup
         spec = self.stability
@@ -361,8 +371,14 @@ def _check_setup(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) -> Non
     if cfg.report.locus_speeds_m_s is not None and not setup.stability:
         raise ValueError(f"report.locus_speeds_m_s: {where} has no forward speed")
     for name in cfg.design.checks:
+        if name == "nonlinear_hunting" and name not in setup.checks:
+            raise ValueError(f"design.checks: {where}: 'nonlinear_hunting' needs a vehicle with wheel and rail "
+                             "profiles (a [wheel_rail] table in its vehicle file: wheel_profile, rail_profile, "
+                             "inclination)")
         if name not in setup.checks:
             raise ValueError(f"design.checks: {where}: {not_one_of(name, sorted(setup.checks), 'check')}")
+    if cfg.nonlinear_hunting is not None and "nonlinear_hunting" not in cfg.design.checks:
+        raise ValueError("nonlinear_hunting: settings given but design.checks does not list 'nonlinear_hunting'")
     # the model must evaluate at every start before anything is written
     for name in cfg.design.start_from:
         point = [setup.named_designs[name][n] for n in names]

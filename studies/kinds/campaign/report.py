@@ -54,8 +54,12 @@ def _search(result: CampaignResult, model: str) -> tuple[float, float] | None:
 def _speeds(result: CampaignResult, model: str, columns) -> dict[str, str]:
     """Columns holding critical speeds -> the words their +inf prints as (:func:`stable_over` the range searched)."""
     search = _search(result, model)
-    return {} if search is None else {str(c): stable_over(search) for c in columns
-                                      if str(c).startswith("critical")}
+    words = {} if search is None else {str(c): stable_over(search) for c in columns
+                                       if str(c).startswith(("critical", "linear_critical"))}
+    # the nonlinear check's value: inf when no speed of its ramp, from the top down, held a hunting cycle
+    words.update({str(c): "no hunting cycle at any ramp speed" for c in columns
+                  if str(c) == "lowest_hunting_speed_m_s"})
+    return words
 
 
 def _csv(result: CampaignResult, df: pd.DataFrame, model: str | None = None) -> pd.DataFrame:
@@ -376,6 +380,15 @@ def _design_table(result: CampaignResult, s: ModelSections, rec: Recommended, re
             ex_check = result.existing_checks.get(s.model, {}).get(name, {})
             ref_value = None if ref is None else ref["checks"][name].payload().get(key)
             add(key, ex_check.get(key), value, ref_value, key)
+        flags = [k for k, v in payload.items() if isinstance(v, bool)]
+        if flags:  # the check's verdict on each design: every flag true
+
+            def passed(p: dict | None, flags: list[str] = flags) -> str | None:
+                return None if not p else ("yes" if all(bool(p.get(f)) for f in flags) else "NO")
+
+            ex_check = result.existing_checks.get(s.model, {}).get(name)
+            ref_payload = None if ref is None else ref["checks"][name].payload()
+            add(f"{name} check passed ({', '.join(flags)})", passed(ex_check), passed(payload), passed(ref_payload))
     for c in rec.constraints:
         ref_peak = None if ref is None else next(
             r["peak"] for r in ref["constraints"] if r["output"] == c["output"])
