@@ -27,6 +27,7 @@ step falls below ``min_step``, or after ``max_points`` points.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -161,7 +162,8 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
                             coordinate: Coordinate, *, speed_range: tuple[float, float], direction: int = -1,
                             options: ContinuationOptions | None = None, shooting: ShootingOptions | None = None,
                             settings: IntegrationSettings | None = None, jacobian: Jacobian | None = None,
-                            linear_critical_speed: float = math.nan) -> BifurcationDiagram:
+                            linear_critical_speed: float = math.nan,
+                            progress: Callable[[str], None] | None = None) -> BifurcationDiagram:
     """Follow ``orbit``'s branch in speed, through folds, until a stopping rule fires.
 
     Parameters
@@ -186,6 +188,8 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         ``jacobian(t, x, speed) -> (n, n)``; central differences when omitted.
     linear_critical_speed : float
         Stored in the diagram for reference (m/s).
+    progress : callable, optional
+        ``progress(line)`` after each point (its speed, amplitude, largest multiplier) and at each fold.
 
     Returns
     -------
@@ -261,6 +265,10 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         points.append(new)
         amplitudes.append(amplitude)
         branch_ids.append(len(folds))
+        if progress is not None:
+            largest = float(np.max(np.abs(new.multipliers))) if new.multipliers.size else math.nan
+            progress(f"point {len(points)}: {speed:.4f} m/s, amplitude {amplitude:.4g}, |multiplier| {largest:.4f}"
+                     + (f", fold at {folds[-1].speed:.4f} m/s" if branch_ids[-1] != branch_ids[-2] else ""))
         beyond = sum(1 for b in branch_ids if b >= 1)
         if options.points_after_fold is not None and beyond >= options.points_after_fold:
             reason = f"{beyond} points beyond the fold at {folds[0].speed:.6g} m/s (points_after_fold)"

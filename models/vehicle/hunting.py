@@ -343,7 +343,8 @@ def nonlinear_hunting(vehicle: Vehicle, analysis: HuntingAnalysis | None = None,
                                   points_after_fold=a.points_after_fold)
     down = continue_periodic_orbit(nv.rhs, orbit, section, watched, speed_range=(a.lowest_speed, top),
                                    direction=-1, options=options, shooting=shooting, settings=settings,
-                                   jacobian=jac, linear_critical_speed=linear)
+                                   jacobian=jac, linear_critical_speed=linear,
+                                   progress=lambda line: say(f"{vehicle.name}: continuation {line}"))
     diagram = dataclasses.replace(down, ramp=ramp)
     critical = diagram.nonlinear_critical_speed()
     say(f"{vehicle.name}: {critical.reason}")
