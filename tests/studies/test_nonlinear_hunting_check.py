@@ -179,3 +179,49 @@ def test_a_campaign_recommends_only_a_design_without_a_hunting_cycle(tmp_path):
     assert "| lowest_hunting_speed_m_s | 45 | no hunting cycle at any ramp speed |" in summary
     assert "| nonlinear_hunting check passed (nonlinear_stable) | NO | yes |" in summary
     assert "| hunting check passed (stable, certified) | yes | yes |" in summary
+
+
+@pytest.mark.slow
+def test_the_study_kind_writes_the_ramp_indicators_and_verdict(tmp_path):
+    """The wheelset through ``railopt run`` (ramp only): the verdict at the required speed follows the ramp's
+    bracket, the indicators are those of the steady speeds, and the flange use is peak |y| over the table's flange
+    onset (6.3 mm on S1002/60E1 1:40, the benchmark's 6.0–6.5 mm)."""
+    study = tmp_path / "nh.toml"
+    study.write_text(f"""
+[study]
+name = "nh"
+kind = "nonlinear_hunting"
+
+[[models]]
+label = "wheelset"
+model = "vehicle_lateral"
+
+[models.options]
+vehicle = "{WHEELSET}"
+max_operating_speed_m_s = 40.0
+
+[nonlinear_hunting]
+top_speed_m_s = 46.0
+step_m_s = 1.0
+fine_step_m_s = 0.5
+lowest_speed_m_s = 43.0
+initial_amplitude_mm = 0.6
+continuation = false
+""")
+    assert main(["run", str(study), "--results", str(tmp_path / "out"), "--no-progress"]) == 0
+    out = tmp_path / "out" / "nh"
+    summary = pd.read_csv(out / "summary.csv").iloc[0]
+    ramp = pd.read_csv(out / "ramp.csv")
+    steady = ramp[ramp["classification"] == "steady"]
+    assert summary["ramp_last_cycle_m_s"] == steady["speed_m_s"].min()
+    assert summary["lowest_hunting_speed_m_s"] == summary["ramp_last_cycle_m_s"] > 40.0
+    assert bool(summary["passes_required"]) and not bool(summary["fold_confirmed"])
+    assert summary["nonlinear_over_linear"] == pytest.approx(summary["lowest_hunting_speed_m_s"]
+                                                             / summary["linear_critical_speed_m_s"], rel=1e-12)
+    indicators = pd.read_csv(out / "indicators.csv")
+    assert list(indicators["speed_m_s"]) == list(steady["speed_m_s"])
+    assert np.allclose(indicators["flange_clearance_mm"], 6.3)
+    assert np.allclose(indicators["flange_use"], indicators["peak_y_mm"] / 6.3, rtol=1e-12)
+    assert np.allclose(indicators["peak_y_mm"], steady["amplitude_mm"], rtol=3e-3)  # a symmetric cycle
+    assert (out / "bifurcation_wheelset.png").is_file()
+    assert "Verdict: no stable hunting cycle up to 40 m/s." in (out / "summary.md").read_text()
