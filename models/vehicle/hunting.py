@@ -290,7 +290,7 @@ def nonlinear_hunting(vehicle: Vehicle, analysis: HuntingAnalysis | None = None,
     settings = IntegrationSettings(method=a.method, rtol=a.rtol, atol=a.atol)
     dwell = Dwell(wavelengths=a.dwell_wavelengths, wavelength_m=wavelength)
     rate = 40.0 * top / wavelength  # 40 samples per kinematic period at the top speed
-    speeds = np.arange(top, a.lowest_speed - 1e-9, -step)
+    speeds = np.round(np.arange(top, a.lowest_speed - 1e-9, -step), 9)  # 81.6, not 81.60000000000001
     say(f"{vehicle.name}: coarse ramp {top:.1f} → {speeds[-1]:.1f} m/s in {step:.2f} m/s steps "
         f"(linear critical speed {linear:.2f} m/s)")
     coarse = speed_ramp(nv.rhs, x0, speeds, dwell, watched, sample_rate_hz=rate, settings=settings)
@@ -301,7 +301,7 @@ def nonlinear_hunting(vehicle: Vehicle, analysis: HuntingAnalysis | None = None,
                              NonlinearCriticalSpeed(math.nan, math.nan, None, False, reason), wavelength, name, reason)
     high = float(coarse.speeds[k])
     low = float(coarse.speeds[k + 1])
-    fine_speeds = np.arange(high - fine, low - 1e-9, -fine)
+    fine_speeds = np.round(np.arange(high - fine, low - 1e-9, -fine), 9)
     if fine_speeds.size >= 2:
         say(f"{vehicle.name}: fine ramp {fine_speeds[0]:.2f} → {fine_speeds[-1]:.2f} m/s in {fine:.2f} m/s steps")
         refined = speed_ramp(nv.rhs, coarse.states[k], fine_speeds, dwell, watched, sample_rate_hz=rate,

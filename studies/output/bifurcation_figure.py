@@ -62,7 +62,7 @@ def plot_bifurcation_diagram(diagram: pd.DataFrame, title: str, amplitude_label:
     ax.set_xlabel("forward speed (m/s)")
     ax.set_ylabel(wrap_title(amplitude_label, 3.8, 9), fontsize=9)
     ax.set_ylim(bottom=0.0)
-    ax.set_title(wrap_title(title, 6.2, 10), fontsize=10)
+    ax.set_title(wrap_title(title, 4.6, 10), fontsize=10)  # the axes' width: the legend sits beside them
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return fig
