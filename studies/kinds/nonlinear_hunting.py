@@ -108,7 +108,8 @@ def _summary_row(label: str, vehicle: dict, r: HuntingResult, required: float, i
             "passes_required": r.passes(required), "verdict": _verdict(r, required),
             "max_flange_use": float(ind["flange_use"].max()) if len(ind) else math.nan,
             "max_sum_y_ratio": float(ind["sum_y_ratio"].max()) if len(ind) else math.nan,
-            "reason": r.reason}
+            "reason": r.reason,
+            "continuation_stop": r.diagram.stop_reason if r.diagram is not None else "not run"}
 
 
 def compute(config: NonlinearHuntingStudyConfig, context: StudyContext) -> HuntingStudyResult:
@@ -189,11 +190,12 @@ def report(result: HuntingStudyResult, writer: Writer) -> str:
                f"{r.linear_critical_speed:.2f} m/s.",
                f"* Descending ramp: a steady hunting cycle down to {high:.2f} m/s, lost at {low:.2f} m/s."
                if np.isfinite(high) else f"* Descending ramp: {r.reason}.",
-               f"* Path following: {r.critical.reason}.",
+               f"* Path following: {r.critical.reason}"
+               + (f" (the continuation stopped: {r.diagram.stop_reason})." if r.diagram is not None else "."),
                f"* Lowest speed with a stable hunting cycle: {row['lowest_hunting_speed_m_s']:.2f} m/s, "
                f"{row['nonlinear_over_linear']:.2f} of the linear critical speed (gap {row['gap_m_s']:.2f} m/s).",
                f"* Verdict: {row['verdict']}.", "", f"![bifurcation diagram]({name}.png)", ""]
-    md += ["## Summary", "", markdown_table(result.table.drop(columns=["reason"])), ""]
+    md += ["## Summary", "", markdown_table(result.table.drop(columns=["reason", "continuation_stop"])), ""]
     if len(result.indicators):
         md += ["## Cycle indicators (EN 14363-style, leading wheelset)", "",
                "ΣY: the largest 100 m sliding r.m.s. of the band-passed (f0 ± 2 Hz) track-shifting force against "
