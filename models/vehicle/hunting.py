@@ -54,6 +54,7 @@ from railopt.models.vehicle.nonlinear import NonlinearVehicle, nonlinear_vehicle
 from railopt.models.vehicle.running_stability import (
     flange_clearance_use,
     max_derailment_quotient,
+    record_duration_s,
     running_stability,
 )
 from railopt.models.vehicle.vehicle import Vehicle
@@ -179,32 +180,34 @@ class HuntingResult:
         return self.ramp.fold_bracket
 
     @property
-    def nonlinear_critical_speed(self) -> float:
-        """The confirmed fold speed (m/s); NaN when not confirmed (see ``critical.reason``)."""
-        return self.critical.speed
+    def steady(self) -> list[int]:
+        """Indices of the ramp speeds where the detector saw a steady cycle."""
+        return [i for i, v in enumerate(self.ramp.verdicts) if v.classification == "steady"]
 
     def lowest_hunting_speed(self) -> float:
         """The lowest speed with a stable hunting cycle found (m/s): the confirmed fold, else the ramp's V_high;
         inf when no steady cycle was seen at any ramp speed."""
         if self.critical.confirmed:
             return self.critical.speed
-        steady = [s for s, v in zip(self.ramp.speeds, self.ramp.verdicts, strict=True)
-                  if v.classification == "steady"]
-        return float(min(steady)) if steady else math.inf
+        return float(min(self.ramp.speeds[self.steady])) if self.steady else math.inf
+
+    def gap(self) -> float:
+        """Linear critical speed − :meth:`lowest_hunting_speed` (m/s); NaN without a hunting cycle."""
+        lowest = self.lowest_hunting_speed()
+        return self.linear_critical_speed - lowest if math.isfinite(lowest) else math.nan
 
     def passes(self, required_speed: float) -> bool | None:
         """True when no stable hunting cycle exists at or below ``required_speed`` (m/s), False when one does,
         None when the ramp's bracket straddles it without a confirmed fold (undecided)."""
         if self.critical.confirmed:
             return bool(self.critical.speed > required_speed)
-        steady = [s for s, v in zip(self.ramp.speeds, self.ramp.verdicts, strict=True)
-                  if v.classification == "steady"]
+        steady = self.ramp.speeds[self.steady]
         if any(s <= required_speed for s in steady):
             return False
         bracket = self.bracket
         if bracket is not None and bracket[0] >= required_speed:
             return True
-        if not steady and all(v.classification in ("decaying", "rest") for v in self.ramp.verdicts):
+        if not len(steady) and all(v.classification in ("decaying", "rest") for v in self.ramp.verdicts):
             return True  # no cycle at any ramp speed, all started from the initial disturbance
         return None
 
@@ -311,10 +314,13 @@ def nonlinear_hunting(vehicle: Vehicle, analysis: HuntingAnalysis | None = None,
         ramp = coarse
     bracket = ramp.fold_bracket
     reason = f"ramp bracket ({bracket[0]:.2f}, {bracket[1]:.2f}] m/s" if bracket else "the ramp lost no cycle"
+
+    def unconfirmed(why: str) -> HuntingResult:
+        critical = NonlinearCriticalSpeed(math.nan, math.nan, bracket, False, why)
+        return HuntingResult(vehicle.name, linear, ramp, None, critical, wavelength, name, why)
+
     if not a.continuation or bracket is None:
-        critical = NonlinearCriticalSpeed(math.nan, math.nan, bracket, False,
-                                          f"{reason}; continuation not run" if bracket else reason)
-        return HuntingResult(vehicle.name, linear, ramp, None, critical, wavelength, name, critical.reason)
+        return unconfirmed(f"{reason}; continuation not run" if bracket else reason)
     j = ramp.last_steady
     speed = float(ramp.speeds[j])
     period = 1.0 / ramp.verdicts[j].frequency_hz
@@ -325,15 +331,11 @@ def nonlinear_hunting(vehicle: Vehicle, analysis: HuntingAnalysis | None = None,
     jac = (lambda t, x, v: nv.jacobian(x, v))  # noqa: E731
     say(f"{vehicle.name}: shooting the cycle at {speed:.2f} m/s")
     if not arrived.t_events[0].size:
-        critical = NonlinearCriticalSpeed(math.nan, math.nan, bracket, False,
-                                          f"{reason}; the state at {speed:.2f} m/s did not reach the section")
-        return HuntingResult(vehicle.name, linear, ramp, None, critical, wavelength, name, critical.reason)
+        return unconfirmed(f"{reason}; the state at {speed:.2f} m/s did not reach the section")
     orbit = find_periodic_orbit(nv.rhs, arrived.y_events[0][0], speed, section, period, watched,
                                 options=shooting, settings=settings, jacobian=jac)
     if not orbit.converged:
-        critical = NonlinearCriticalSpeed(math.nan, math.nan, bracket, False,
-                                          f"{reason}; no periodic orbit at {speed:.2f} m/s: {orbit.reason}")
-        return HuntingResult(vehicle.name, linear, ramp, None, critical, wavelength, name, critical.reason)
+        return unconfirmed(f"{reason}; no periodic orbit at {speed:.2f} m/s: {orbit.reason}")
     say(f"{vehicle.name}: continuing the cycle from {speed:.2f} m/s (amplitude {orbit.amplitude * 1e3:.3f} mm)")
     # scaled so that the cycle's velocities (≈ 2πf × amplitude, the largest free coordinates on the section) are
     # O(1) and a step of 0.05 moves the speed by about a fifth of the fine ramp step
@@ -452,20 +454,14 @@ def cycle_indicators(nv: NonlinearVehicle, vehicle: Vehicle, speed: float, state
     axle_load = nv.forces.axle_load
     frequency = 1.0 / period
     dt = period / samples_per_period
-    # the record the criterion needs: the filter's settling time and one window, in whole periods (a record that
-    # is still too short is refused by running_stability naming t_s: lengthen it)
+    # the record the criterion needs (the filter's settling time and one window) in whole periods: the window and
+    # 5 s, doubled while shorter than that
+    needed = record_duration_s(frequency, dt, speed, window_m=window_m)
     repeats = int(math.ceil((window_m / speed + 5.0) / period))
-    for _ in range(6):
-        try:
-            record = running_stability(np.arange(repeats * samples_per_period) * dt, np.tile(sum_y, repeats),
-                                       speed, axle_load, frequency_hz=frequency, window_m=window_m)
-            break
-        except ValueError as error:
-            if not str(error).startswith("t_s"):
-                raise
-            repeats *= 2
-    else:  # pragma: no cover - six doublings cover any filter that running_stability accepts
-        raise ValueError(f"t_s: no record long enough for the ΣY criterion at {speed:g} m/s")
+    while (repeats * samples_per_period - 1) * dt < needed:
+        repeats *= 2
+    record = running_stability(np.arange(repeats * samples_per_period) * dt, np.tile(sum_y, repeats), speed,
+                               axle_load, frequency_hz=frequency, window_m=window_m)
     clearance = vehicle.contact_table().flange_onset()
     use = flange_clearance_use(x[index], clearance)
     quotient = max(max_derailment_quotient(np.array([c.Y[s, k] for c in contact]),

@@ -49,6 +49,7 @@ __all__ = [
     "estimate_frequency",
     "flange_clearance_use",
     "max_derailment_quotient",
+    "record_duration_s",
     "running_stability",
     "sliding_rms",
     "sum_y_limit",
@@ -276,6 +277,17 @@ def _settle_samples(sos: np.ndarray) -> int:
     _, poles, _ = sps.sos2zpk(sos)
     radius = float(np.max(np.abs(poles)))
     return int(math.ceil(math.log(SETTLE_DECAY) / math.log(radius)))
+
+
+def record_duration_s(frequency_hz: float, sample_interval_s: float, speed_m_s: float, *, window_m: float = 100.0,
+                      band_half_width_hz: float = 2.0, filter_order: int = 4) -> float:
+    """The shortest uniformly sampled record (s) that :func:`running_stability` accepts, filtered: the band-pass
+    filter's settling time (its slowest pole decayed by :data:`SETTLE_DECAY`) plus one ``window_m`` at
+    ``speed_m_s``.  Raises ValueError (naming the argument) where the band does not fit the sampling."""
+    sos = _band_pass(number("frequency_hz", frequency_hz, positive=True),
+                     number("band_half_width_hz", band_half_width_hz, positive=True),
+                     number("sample_interval_s", sample_interval_s, positive=True), int(filter_order))
+    return _settle_samples(sos) * sample_interval_s + window_m / number("speed_m_s", speed_m_s, positive=True)
 
 
 def running_stability(t_s: object, sum_y_n: object, speed_m_s: float, axle_load_n: float, *,

@@ -6,7 +6,6 @@ real part of the roots, :class:`HuntingCheck` the critical speed and least dampi
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Protocol
@@ -199,6 +198,6 @@ class NonlinearHuntingCheck:
         data = {"lowest_hunting_speed_m_s": lowest, "ramp_top_speed_m_s": float(r.ramp.speeds[0]),
                 "ramp_last_cycle_m_s": high, "ramp_lost_cycle_at_m_s": low, "fold_speed_m_s": r.critical.fold_speed,
                 "fold_confirmed": float(r.critical.confirmed), "linear_critical_speed_m_s": r.linear_critical_speed,
-                "hunting_gap_m_s": r.linear_critical_speed - lowest if math.isfinite(lowest) else math.nan,
+                "hunting_gap_m_s": r.gap(),
                 "nonlinear_required_speed_m_s": self.max_speed}
         return CheckResult(lowest, {"nonlinear_stable": passes is True}, data)

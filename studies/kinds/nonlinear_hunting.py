@@ -104,7 +104,7 @@ def _summary_row(label: str, vehicle: dict, r: HuntingResult, required: float, i
             "fold_confirmed": r.critical.confirmed, "nonlinear_critical_speed_m_s": r.critical.speed,
             "lowest_hunting_speed_m_s": lowest,
             "nonlinear_over_linear": lowest / r.linear_critical_speed if math.isfinite(lowest) else math.nan,
-            "gap_m_s": r.linear_critical_speed - lowest, "required_speed_m_s": required,
+            "gap_m_s": r.gap(), "required_speed_m_s": required,
             "passes_required": r.passes(required), "verdict": _verdict(r, required),
             "max_flange_use": float(ind["flange_use"].max()) if len(ind) else math.nan,
             "max_sum_y_ratio": float(ind["sum_y_ratio"].max()) if len(ind) else math.nan,
@@ -144,11 +144,10 @@ def compute(config: NonlinearHuntingStudyConfig, context: StudyContext) -> Hunti
             say("ΣY, flange use and Y/Q at each steady ramp speed")
             nv = profile_vehicle(vehicle, analysis.friction_coefficient, analysis.flange)
             settings = IntegrationSettings(method=analysis.method, rtol=analysis.rtol, atol=analysis.atol)
-            steady = [(s, x) for s, v, x in zip(result.ramp.speeds, result.ramp.verdicts, result.ramp.states,
-                                                 strict=True) if v.classification == "steady"]
-            ind = pd.DataFrame([{"model": ref.label, **cycle_indicators(nv, vehicle, float(s), x, result.watched,
-                                                                        settings, window_m=spec.window_m).to_dict()}
-                                for s, x in steady])
+            ramp = result.ramp
+            ind = pd.DataFrame([{"model": ref.label, **cycle_indicators(
+                nv, vehicle, float(ramp.speeds[i]), ramp.states[i], result.watched, settings,
+                window_m=spec.window_m).to_dict()} for i in result.steady])
             indicators.append(ind)
         rows.append(_summary_row(ref.label, vehicles.get(ref.label, {}), result, required, ind))
 

@@ -244,3 +244,18 @@ def test_max_derailment_quotient_by_hand() -> None:
         max_derailment_quotient([1.0, 2.0], [5.0, 0.0])
     with pytest.raises(ValueError, match="^Q: shape"):
         max_derailment_quotient([1.0, 2.0], [5.0])
+
+
+def test_record_duration_is_the_length_running_stability_demands():
+    """The shortest record it accepts: one sample short of record_duration_s is refused naming t_s, the record
+    that reaches it is accepted."""
+    from railopt.models.vehicle.running_stability import record_duration_s
+
+    f0, dt, speed = 7.0, 1.0 / 400.0, 60.0
+    needed = record_duration_s(f0, dt, speed)
+    n = int(np.ceil(needed / dt)) + 1
+    t = np.arange(n) * dt
+    y = np.sin(2 * np.pi * f0 * t)
+    running_stability(t, y, speed, 160e3, frequency_hz=f0)
+    with pytest.raises(ValueError, match="t_s"):
+        running_stability(t[:-2], y[:-2], speed, 160e3, frequency_hz=f0)
