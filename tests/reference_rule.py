@@ -1,0 +1,69 @@
+"""The rule a fresh run of a bundled study is held to against its committed reference under ``results/``.
+
+Since the compiled kernels (issue 25) the references are compared at the optimiser's tolerance, not bit for bit:
+
+* U — every column that holds a band maximum (``U``, ``value``, ``existing_U``, ``U_objective``, ``peak``, …):
+  1e-9 relative;
+* every other real number (design variables, speeds, damping ratios, changes, …): 1e-6 relative — designs are
+  what the optimiser fixes to its tolerance, and the quantities derived from a design inherit it;
+* counts of distinct optima, start counts, statuses, flags, labels and every other non-real column: exactly;
+* wall times, timestamps, the machine and a start's evaluation count (the optimiser's path, which rounding may
+  lengthen or shorten by a step) are left out.
+
+docs/reliability.md states the same rule for readers.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+U_COLUMNS = {"U", "value", "existing_U", "U_objective", "true_peak", "peak", "nishihara_asami_peak", "before",
+             "after", "amplitude", "t"}
+U_RTOL = 1e-9
+DESIGN_RTOL = 1e-6
+VOLATILE = {"timing.csv"}
+
+
+def _volatile(column: str) -> bool:
+    return column.startswith("wall_time") or column in {"finished_utc", "evaluations"}
+
+
+def tables(folder: Path) -> dict[str, pd.DataFrame]:
+    """Every CSV of a study folder but timing.csv, without wall times, timestamps and evaluation counts."""
+    out = {}
+    for path in sorted(folder.glob("*.csv")):
+        if path.name not in VOLATILE:
+            df = pd.read_csv(path)
+            out[path.stem] = df.drop(columns=[c for c in df.columns if _volatile(c)])
+    return out
+
+
+def differences(fresh: pd.DataFrame, committed: pd.DataFrame) -> list[str]:
+    """Cells of ``fresh`` outside the rule against ``committed`` (same shape and columns), as readable lines."""
+    if list(fresh.columns) != list(committed.columns) or len(fresh) != len(committed):
+        return [f"shape or columns differ: {fresh.shape} {list(fresh.columns)} vs {committed.shape} "
+                f"{list(committed.columns)}"]
+    out = []
+    for column in committed.columns:
+        a, b = fresh[column], committed[column]
+        if pd.api.types.is_float_dtype(b) or pd.api.types.is_float_dtype(a):
+            x, y = a.to_numpy(float), b.to_numpy(float)
+            rtol = U_RTOL if column in U_COLUMNS else DESIGN_RTOL
+            bad = ~np.isclose(x, y, rtol=rtol, atol=0.0, equal_nan=True)
+            out += [f"{column}[{i}]: {x[i]!r} vs {y[i]!r} (rel {abs(x[i] - y[i]) / max(abs(y[i]), 1e-300):.1e} > "
+                    f"{rtol:g})" for i in np.flatnonzero(bad)]
+        elif not a.equals(b):
+            out += [f"{column}[{i}]: {a.iloc[i]!r} vs {b.iloc[i]!r} (exact)" for i in np.flatnonzero(
+                (a.astype(str) != b.astype(str)).to_numpy())]
+    return out
+
+
+def assert_matches_reference(fresh_folder: Path, committed_folder: Path) -> None:
+    """Assert that every table of a fresh run matches the committed reference under the rule."""
+    fresh, committed = tables(fresh_folder), tables(committed_folder)
+    assert sorted(fresh) == sorted(committed)
+    problems = [f"{name}.{line}" for name in committed for line in differences(fresh[name], committed[name])]
+    assert not problems, "\n".join(problems[:40])

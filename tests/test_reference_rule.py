@@ -1,0 +1,28 @@
+"""The reference rule (tests/reference_rule.py) itself: each tolerance lets through what it states and no more."""
+
+from __future__ import annotations
+
+import pandas as pd
+from reference_rule import differences
+
+
+def _table(**changes) -> pd.DataFrame:
+    row = {"cluster": 0, "value": 0.25, "count": 3, "stiffness": 1.5e6, "status": "converged", "stable": True}
+    row.update(changes)
+    return pd.DataFrame([row])
+
+
+def test_u_holds_to_1e9_designs_to_1e6_and_labels_counts_flags_exactly():
+    base = _table()
+    assert differences(_table(value=0.25 * (1 + 5e-10), stiffness=1.5e6 * (1 + 5e-7)), base) == []
+    assert [d.split("[")[0] for d in differences(_table(value=0.25 * (1 + 2e-9)), base)] == ["value"]
+    assert [d.split("[")[0] for d in differences(_table(stiffness=1.5e6 * (1 + 2e-6)), base)] == ["stiffness"]
+    for column, other in (("count", 4), ("status", "failed"), ("stable", False)):
+        found = differences(_table(**{column: other}), base)
+        assert len(found) == 1 and found[0].startswith(column) and "exact" in found[0]
+
+
+def test_a_missing_row_or_column_is_a_difference():
+    base = _table()
+    assert "shape or columns" in differences(pd.concat([base, base]), base)[0]
+    assert "shape or columns" in differences(base.drop(columns="status"), base)[0]
