@@ -12,7 +12,10 @@ Step control: h grows by 1.3 after a corrector of ≤ 3 iterations and shrinks b
 a failed corrector, or a turn of the tangent by more than ``max_turn_deg``, halves h and retries.  Folds are
 where the tangent's speed component changes sign between two points; each is located by Brent's method on the
 arclength h ∈ (0, h_step) from the earlier point (the speed component of the tangent at the corrected point as
-the function), so the fold speed is as accurate as the corrector (Keller, "Numerical solution of bifurcation and
+the function), so the fold speed is as accurate as the corrector.  On a non-smooth map (tabulated contact
+geometry with two-point-contact jumps) Newton can fail at a trial point inside a step whose ends both converged;
+the fold is then the extremum of the cubic Hermite interpolant of V(s) through those two corrected points and
+their tangents, and is marked ``located = "hermite"`` (Keller, "Numerical solution of bifurcation and
 nonlinear eigenvalue problems", in *Applications of Bifurcation Theory*, Academic Press 1977; Seydel 2010).
 
 Stability of each point: all non-trivial Floquet multipliers (eigenvalues of DP) inside the unit circle.
@@ -257,7 +260,7 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
             break
         if np.sign(new.tangent[-1]) != np.sign(here.tangent[-1]) and here.tangent[-1] != 0:
             try:
-                folds.append(_locate_fold(branch, here, h, rhs, coordinate, settings))
+                folds.append(_locate_fold(branch, here, new, h, rhs, coordinate, settings))
             except ValueError as error:
                 reason = (f"a fold between {here.u[-1] * options.speed_scale:.6g} and {speed:.6g} m/s could not "
                           f"be located: {error}")
@@ -268,7 +271,8 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         if progress is not None:
             largest = float(np.max(np.abs(new.multipliers))) if new.multipliers.size else math.nan
             progress(f"point {len(points)}: {speed:.4f} m/s, amplitude {amplitude:.4g}, |multiplier| {largest:.4f}"
-                     + (f", fold at {folds[-1].speed:.4f} m/s" if branch_ids[-1] != branch_ids[-2] else ""))
+                     + (f", fold at {folds[-1].speed:.4f} m/s ({folds[-1].located})"
+                        if branch_ids[-1] != branch_ids[-2] else ""))
         beyond = sum(1 for b in branch_ids if b >= 1)
         if options.points_after_fold is not None and beyond >= options.points_after_fold:
             reason = f"{beyond} points beyond the fold at {folds[0].speed:.6g} m/s (points_after_fold)"
@@ -292,31 +296,95 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         linear_critical_speed=float(linear_critical_speed))
 
 
-def _locate_fold(branch: _Branch, here: _Point, h: float, rhs: RightHandSide, coordinate: Coordinate,
-                 settings: IntegrationSettings) -> Fold:
-    """Brent's method on the arclength s ∈ (0, h) for a zero of the tangent's speed component."""
+def _locate_fold(branch: _Branch, here: _Point, new: _Point, h: float, rhs: RightHandSide,
+                 coordinate: Coordinate, settings: IntegrationSettings) -> Fold:
+    """Brent's method on the arclength s ∈ (0, h) for a zero of the tangent's speed component; the cubic Hermite
+    extremum through ``here`` and ``new`` when the corrector fails inside the step (see the module docstring)."""
     cache: dict[float, _Point] = {}
+    between = (float(here.u[-1] * branch.scale[-1]), float(new.u[-1] * branch.scale[-1]))
 
     def speed_component(s: float) -> float:
         if s == 0.0:
             return float(here.tangent[-1])
         point = branch.correct(here.u + s * here.tangent, here.tangent, here.period)
         if point is None:
-            raise ValueError(f"fold: corrector failed at arclength {s:g} while locating the fold")
+            raise _CorrectorFailed(s)
         cache[s] = point
         return float(point.tangent[-1])
 
-    if speed_component(0.0) * speed_component(h) > 0:
-        raise ValueError("fold: the tangent's speed component has the same sign at both ends of the step")
-    s_fold = brentq(speed_component, 0.0, h, xtol=1e-12 * h, rtol=4 * np.finfo(float).eps)
+    try:
+        if speed_component(0.0) * speed_component(h) > 0:
+            raise ValueError("fold: the tangent's speed component has the same sign at both ends of the step")
+        s_fold = brentq(speed_component, 0.0, h, xtol=1e-12 * h, rtol=4 * np.finfo(float).eps)
+    except _CorrectorFailed:
+        speed_scaled, w = hermite_turn(here.u, here.tangent, new.u, new.tangent)
+        x = branch.section.place((1 - w) * here.u[:-1] * branch.scale[:-1] + w * new.u[:-1] * branch.scale[:-1],
+                                 branch.n)
+        speed = float(speed_scaled * branch.scale[-1])
+        period = (1 - w) * here.period + w * new.period
+        amplitude = orbit_amplitude(rhs, x, speed, period, coordinate, settings)
+        return Fold(speed, amplitude, period, x, located="hermite", between=between)
     point = cache.get(s_fold) or branch.correct(here.u + s_fold * here.tangent, here.tangent, here.period)
     x, speed = branch.state(point.u)
     amplitude = orbit_amplitude(rhs, x, speed, point.period, coordinate, settings)
-    return Fold(float(speed), amplitude, point.period, x)
+    return Fold(float(speed), amplitude, point.period, x, located="brent", between=between)
+
+
+class _CorrectorFailed(Exception):
+    """The corrector did not converge at a trial arclength while locating a fold."""
+
+
+def hermite_turn(u0: np.ndarray, t0: np.ndarray, u1: np.ndarray, t1: np.ndarray) -> tuple[float, float]:
+    """Extremum of the last coordinate along a branch between two points, from a cubic Hermite interpolant.
+
+    The branch between ``u0`` and ``u1`` (scaled points, last coordinate the parameter) is parametrised by
+    arclength s ∈ [0, L] with L = |u1 − u0| (the chord); V(s) is the cubic with V(0) = u0[−1], V(L) = u1[−1],
+    V'(0) = t0[−1], V'(L) = t1[−1] (unit tangents), whose derivative — a quadratic — is zero at the turn.
+
+    Parameters
+    ----------
+    u0, u1 : (m,) ndarray
+        Two points on the branch (scaled).
+    t0, t1 : (m,) ndarray
+        Unit tangents there, oriented along the branch; ``t0[-1]`` and ``t1[-1]`` of opposite signs.
+
+    Returns
+    -------
+    (float, float)
+        The extremal value of the last coordinate (scaled) and the fraction w = s/L ∈ [0, 1] where it lies.
+
+    Raises
+    ------
+    ValueError
+        If the tangents' last components do not change sign (no turn between the points).
+    """
+    d0, d1 = float(t0[-1]), float(t1[-1])
+    if d0 * d1 > 0:
+        raise ValueError("hermite_turn: the tangents' last components have the same sign (no turn)")
+    length = float(np.linalg.norm(np.asarray(u1) - np.asarray(u0)))
+    v0, v1 = float(u0[-1]), float(u1[-1])
+    # V(w) on w = s/L ∈ [0, 1]: Hermite basis with slopes m0 = L·d0, m1 = L·d1; V'(w) = a w² + b w + c
+    m0, m1 = length * d0, length * d1
+    a = 6 * v0 + 3 * m0 - 6 * v1 + 3 * m1
+    b = -6 * v0 - 4 * m0 + 6 * v1 - 2 * m1
+    c = m0
+    if abs(a) <= 1e-14 * (abs(b) + abs(c)):
+        roots = [-c / b] if b != 0 else [0.0]
+    else:
+        disc = math.sqrt(max(b * b - 4 * a * c, 0.0))
+        q = -0.5 * (b + math.copysign(disc, b))  # the stable quadratic formula
+        roots = [q / a, c / q] if q != 0 else [0.0]
+    w = min((r for r in roots if -1e-12 <= r <= 1 + 1e-12), key=lambda r: abs(r - 0.5), default=None)
+    if w is None:
+        raise ValueError("hermite_turn: no turn of the cubic inside the step")
+    w = min(max(w, 0.0), 1.0)
+    h00, h10, h01, h11 = 2 * w**3 - 3 * w**2 + 1, w**3 - 2 * w**2 + w, -2 * w**3 + 3 * w**2, w**3 - w**2
+    return h00 * v0 + h10 * m0 + h01 * v1 + h11 * m1, w
 
 
 __all__ = [
     "EDGE_TOL",
     "ContinuationOptions",
     "continue_periodic_orbit",
+    "hermite_turn",
 ]

@@ -33,12 +33,23 @@ class Fold(ArrayRecord):
         s.
     point : (n,) ndarray
         The orbit's point on the Poincaré section at the fold.
+    located : str
+        How the speed was found: ``"brent"`` — the zero of the tangent's speed component, each trial point
+        corrected onto the branch (as accurate as the corrector); ``"hermite"`` — the corrector failed inside the
+        step (a non-smooth map: contact tables), so the speed is the extremum of the cubic Hermite interpolant
+        of V(s) through the two corrected points around the turn and their tangents (error O(L⁴), L the chord),
+        and ``amplitude``, ``period`` and ``point`` are interpolated between those two points.
+    between : (float, float)
+        Speeds of the two corrected branch points around the turn (m/s); a fold to lower speeds lies at or below
+        both.
     """
 
     speed: float
     amplitude: float
     period: float
     point: np.ndarray
+    located: str = "brent"
+    between: tuple[float, float] = (math.nan, math.nan)
 
 
 @dataclass(frozen=True)
@@ -115,13 +126,15 @@ class BifurcationDiagram(ArrayRecord):
     def to_pandas(self) -> pd.DataFrame:
         """One row per point: speed_m_s, amplitude, period_s, frequency_hz, max_abs_multiplier, stable, branch.
 
-        ``attrs`` carry fold_speeds_m_s, linear_critical_speed_m_s and stop_reason.
+        ``attrs`` carry fold_speeds_m_s, fold_located (how each was found), linear_critical_speed_m_s and
+        stop_reason.
         """
         largest = np.abs(self.multipliers).max(axis=1) if self.multipliers.size else np.full(self.speed.size, np.nan)
         table = pd.DataFrame({"speed_m_s": self.speed, "amplitude": self.amplitude, "period_s": self.period,
                               "frequency_hz": 1.0 / self.period, "max_abs_multiplier": largest,
                               "stable": self.stable, "branch": self.branch})
         table.attrs.update(fold_speeds_m_s=[f.speed for f in self.folds],
+                           fold_located=[f.located for f in self.folds],
                            linear_critical_speed_m_s=self.linear_critical_speed, stop_reason=self.stop_reason)
         return table
 

@@ -96,12 +96,19 @@ def _verdict(result: HuntingResult, required: float) -> str:
             else f"a stable hunting cycle at or below {required:g} m/s")
 
 
+def _located(r: HuntingResult) -> str:
+    """How the lowest fold was located (``Fold.located``: brent or hermite); empty without a fold."""
+    folds = [] if r.diagram is None else sorted(r.diagram.folds, key=lambda f: f.speed)
+    return folds[0].located if folds else ""
+
+
 def _summary_row(label: str, vehicle: dict, r: HuntingResult, required: float, ind: pd.DataFrame) -> dict:
     low, high = r.bracket if r.bracket is not None else (math.nan, math.nan)
     lowest = r.lowest_hunting_speed()
     return {"model": label, **vehicle, "linear_critical_speed_m_s": r.linear_critical_speed,
             "ramp_last_cycle_m_s": high, "ramp_lost_cycle_at_m_s": low, "fold_speed_m_s": r.critical.fold_speed,
-            "fold_confirmed": r.critical.confirmed, "nonlinear_critical_speed_m_s": r.critical.speed,
+            "fold_located": _located(r), "fold_confirmed": r.critical.confirmed,
+            "nonlinear_critical_speed_m_s": r.critical.speed,
             "lowest_hunting_speed_m_s": lowest,
             "nonlinear_over_linear": lowest / r.linear_critical_speed if math.isfinite(lowest) else math.nan,
             "gap_m_s": r.gap(), "required_speed_m_s": required,

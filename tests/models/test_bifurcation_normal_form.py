@@ -28,6 +28,7 @@ from railopt.models.bifurcation import (
     detect_limit_cycle,
     find_periodic_orbit,
 )
+from railopt.models.bifurcation.continuation import hermite_turn
 
 V_C, V_REF = 30.0, 20.0  # m/s: Hopf at 30 m/s, μ changes by 1 over 20 m/s
 OMEGA = 2 * math.pi * 1.3  # rad/s: the cycles run at 1.3 Hz
@@ -169,3 +170,50 @@ def test_every_integration_method_gives_the_closed_form_cycle(method, rtol):
     assert orbit.converged, orbit.reason
     assert orbit.amplitude == pytest.approx(r, rel=1e-6)
     assert abs(orbit.multipliers[0] - multiplier(speed, r)) < 1e-5
+
+
+def _on_curve(r: float) -> tuple[np.ndarray, np.ndarray]:
+    """A point (r, μ) of the closed-form cycle family μ = r⁴ − r² (from r' = 0) and its unit tangent, oriented
+    towards larger r."""
+    u = np.array([r, r**4 - r**2])
+    t = np.array([1.0, 4 * r**3 - 2 * r])
+    return u, t / np.linalg.norm(t)
+
+
+def test_hermite_turn_finds_the_closed_form_fold_with_fourth_order_accuracy():
+    # the family turns at r² = 1/2, μ = −1/4; points straddle it unevenly, at shrinking spacing
+    errors = []
+    for spacing in (0.2, 0.1, 0.05):
+        u0, t0 = _on_curve(math.sqrt(0.5) - 0.4 * spacing)
+        u1, t1 = _on_curve(math.sqrt(0.5) + 0.6 * spacing)
+        value, w = hermite_turn(u0, t0, u1, t1)
+        assert 0.0 < w < 1.0
+        assert value <= min(u0[1], u1[1])  # the turn lies below both points
+        errors.append(abs(value + 0.25))
+    assert errors[-1] < 1e-5  # measured 5.9e-6 at spacing 0.05 (1.7e-3, 1.0e-4 at 0.2, 0.1)
+    # halving the spacing divides the error by about 16 (fourth order: the interpolant is exact to cubics)
+    assert errors[0] / errors[1] > 12 and errors[1] / errors[2] > 12
+    with pytest.raises(ValueError, match="no turn"):
+        hermite_turn(*_on_curve(0.3), *_on_curve(0.4))
+
+
+def test_a_fold_the_corrector_cannot_bracket_is_located_by_hermite_and_marked(monkeypatch):
+    """The coach's failure mode — Newton fails at trial points inside the turning step on a non-smooth map —
+    forced here on the smooth normal form: the fold then comes from the two corrected points around the turn."""
+    from railopt.models.bifurcation import continuation
+
+    def failing_brentq(fun, a, b, **kwargs):
+        raise continuation._CorrectorFailed(0.5 * (a + b))
+
+    monkeypatch.setattr(continuation, "brentq", failing_brentq)
+    start = find_periodic_orbit(rhs, np.array([1.05, 0.0]), 33.0, SECTION, PERIOD, 0)
+    diagram = continue_periodic_orbit(rhs, start, SECTION, 0, speed_range=(20.0, 34.0),
+                                      options=ContinuationOptions(speed_scale=V_REF, points_after_fold=3),
+                                      shooting=ShootingOptions(min_amplitude=0.05))
+    assert len(diagram.folds) == 1
+    fold = diagram.folds[0]
+    assert fold.located == "hermite"
+    assert fold.speed <= min(fold.between) and V_FOLD < min(fold.between) < V_FOLD + 1.0
+    assert fold.speed == pytest.approx(V_FOLD, abs=5e-3)  # m/s; measured 1.8e-4 (the chord was 0.09 m/s)
+    assert fold.amplitude == pytest.approx(math.sqrt(0.5), rel=2e-3)  # measured 2.9e-4
+    assert diagram.to_pandas().attrs["fold_located"] == ["hermite"]
