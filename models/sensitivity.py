@@ -40,17 +40,36 @@ def eigenvalue_derivatives(system: LinearSystem, dM: np.ndarray, dC: np.ndarray,
 
     First-order perturbation with the left/right eigenvectors of the system's decomposition:
     ``ds_k = W_k dG V_k`` with ``dG = −[0; M⁻¹(dK − dM M⁻¹K), M⁻¹(dC − dM M⁻¹C)]`` (only the lower
-    block row of G moves).  Roots in the order of ``system.modal().s``.
+    block row of G moves).  Roots in the order of ``system.modal().s``.  One member of
+    :func:`stacked_eigenvalue_derivatives` (a stack of one).
     """
     m = system.modal()
-    n = system.n
     AB = np.linalg.solve(system.M, np.hstack([system.K, system.C]))  # [M⁻¹K, M⁻¹C]
     W = left_eigenvectors(system)
-    out = np.zeros((2 * n, len(dK)), dtype=complex)
-    for i in range(len(dK)):
-        dAB = -np.linalg.solve(system.M, np.hstack([dK[i], dC[i]]) - dM[i] @ AB)
-        out[:, i] = np.einsum("kj,jk->k", W[:, n:], dAB @ m.V)
-    return out
+    return stacked_eigenvalue_derivatives(system.M, AB[None], m.V[None], W[None], dM, dC, dK)[0]
+
+
+def stacked_eigenvalue_derivatives(M: np.ndarray, AB: np.ndarray, V: np.ndarray, W: np.ndarray, dM: np.ndarray,
+                                   dC: np.ndarray, dK: np.ndarray) -> np.ndarray:
+    """``ds_k/dθ`` (S, 2n, Q) of every root of S state matrices at once (one member per speed of a family).
+
+    ``G_s = [[0, I], [−AB_s]]`` (4.53) with ``AB_s = M⁻¹[K, C_s]`` (S, n, 2n); ``M`` (n, n), shared by the stack;
+    ``V`` (S, 2n, 2n) the right eigenvectors (columns) and ``W`` (S, 2n, 2n) the left ones (rows, ``W V = I``:
+    :func:`stacked_left_eigenvectors`); ``(dM, dC, dK)`` (Q, n, n) each, the same perturbations for every member.
+    First order: ``ds_k = W_k dG V_k / (W_k V_k)`` with ``W_k V_k = 1`` and
+    ``dG_s = −[0; M⁻¹(dK − dM AB_K), M⁻¹(dC − dM AB_C,s)]`` (thesis (4.53)–(4.58); only the lower block row of G
+    moves).  Every column is computed alone, so the columns of a subset of the perturbations are those of the whole
+    set, bit for bit.  Roots in the order of each member's eigen-decomposition.
+    """
+    n = M.shape[0]
+    rates = np.concatenate([dK, dC], axis=2)  # (Q, n, 2n)
+    if np.any(dM):  # (S, Q, n, 2n): a mass perturbation moves both blocks through AB
+        rates = rates - np.asarray(dM)[None] @ AB[:, None]
+    dAB = -np.linalg.solve(M, rates)  # (Q, n, 2n) or (S, Q, n, 2n)
+    T = dAB @ V[:, None]  # (S, Q, n, 2n): the lower block rows of dG V
+    # ds[s, k, q] = Σ_j W[s, k, n + j] T[s, q, j, k], each row summed alone over j (a C-ordered product)
+    product = np.multiply(W[:, None, :, n:], np.swapaxes(T, -1, -2), order="C")  # (S, Q, 2n, n)
+    return np.swapaxes(product.sum(axis=-1), -1, -2)
 
 
 LEFT_CONDITION = 1e6  # cond₁(V) above which the left eigenvectors come from eig(Gᵀ), not from W = V⁻¹
@@ -70,20 +89,50 @@ def left_eigenvectors(system: LinearSystem) -> np.ndarray:
     m = system.modal()
     if m.condition <= LEFT_CONDITION:
         return m.W
-    s_left, U = np.linalg.eig(system.state_matrix().T)
-    distance = np.abs(m.s[:, None] - s_left[None, :])
-    match = np.empty(len(m.s), dtype=np.intp)
+    return _transposed_left(system.state_matrix(), m.s, m.V)
+
+
+def stacked_left_eigenvectors(G: np.ndarray, s: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """:func:`left_eigenvectors` of S state matrices at once: ``G`` (S, N, N), their roots ``s`` (S, N) and right
+    eigenvectors ``V`` (S, N, N) → the left ones (S, N, N), rows, ``W V = I``.
+
+    ``W = V⁻¹`` by one stacked solve; a member with cond₁(V) = ‖V‖₁‖V⁻¹‖₁ above :data:`LEFT_CONDITION` (or a V
+    singular to working precision) gets its rows from eig(Gᵀ) as :func:`left_eigenvectors` does.
+    """
+    eye = np.eye(V.shape[-1])
+    try:
+        W = np.linalg.solve(V, eye)
+    except np.linalg.LinAlgError:  # one member exactly singular: solve them one by one, the singular ones NaN
+        W = np.full(V.shape, np.nan, dtype=complex)
+        for k in range(len(V)):
+            try:
+                W[k] = np.linalg.solve(V[k], eye)
+            except np.linalg.LinAlgError:
+                pass
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflowing or NaN product: the eig(Gᵀ) rows below
+        condition = np.linalg.norm(V, 1, axis=(-2, -1)) * np.linalg.norm(W, 1, axis=(-2, -1))
+    for k in np.flatnonzero(~(condition <= LEFT_CONDITION)):
+        W[k] = _transposed_left(G[k], s[k], V[k])
+    return W
+
+
+def _transposed_left(G: np.ndarray, s: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """The left eigenvectors of one G from eig(Gᵀ), matched root by root and normalised cluster by cluster (see
+    :func:`left_eigenvectors`)."""
+    s_left, U = np.linalg.eig(G.T)
+    distance = np.abs(s[:, None] - s_left[None, :])
+    match = np.empty(len(s), dtype=np.intp)
     free = np.ones(len(s_left), dtype=bool)
     for k in np.argsort(np.min(distance, axis=1)):  # each root its nearest unused root of Gᵀ, closest pairs first
         j = int(np.argmin(np.where(free, distance[k], np.inf)))
         match[k], free[j] = j, False
     W = U[:, match].T
-    right = mode_order(m.s)
-    sorted_s = m.s[right]
-    tol = 1e-8 * float(np.max(np.abs(m.s), initial=0.0))
+    right = mode_order(s)
+    sorted_s = s[right]
+    tol = 1e-8 * float(np.max(np.abs(s), initial=0.0))
     cuts = np.flatnonzero(np.abs(np.diff(sorted_s)) > tol) + 1
     for cluster in np.split(right, cuts):
-        Y, X = W[cluster], m.V[:, cluster]
+        Y, X = W[cluster], V[:, cluster]
         try:
             with np.errstate(all="ignore"):
                 W[cluster] = np.linalg.solve(Y @ X, Y)
@@ -239,4 +288,5 @@ def damping_ratio_jacobian(s: np.ndarray, ds: np.ndarray) -> np.ndarray:
 __all__ = [
     "LEFT_CONDITION", "damped_frequency_jacobian", "damping_ratio_jacobian", "eigenvalue_derivatives",
     "left_eigenvectors", "maxima_jacobians", "response_maxima_jacobian", "root_jacobian", "root_speed_derivative",
+    "stacked_eigenvalue_derivatives", "stacked_left_eigenvectors",
 ]

@@ -220,11 +220,12 @@ def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_pat
 
     calls, maxima, roots, members = [], [], [], []
     real, real_maxima = adapter.maxima_jacobians, adapter.all_response_maxima
-    real_roots, real_members = rows_module.eigenvalue_derivatives, rows_module._family_rows
+    real_roots, real_members = rows_module.stacked_eigenvalue_derivatives, rows_module._family_rows
     monkeypatch.setattr(adapter, "maxima_jacobians", lambda *a, **k: calls.append(1) or real(*a, **k))
     for module in (adapter, sensitivity):
         monkeypatch.setattr(module, "all_response_maxima", lambda *a, **k: maxima.append(1) or real_maxima(*a, **k))
-    monkeypatch.setattr(rows_module, "eigenvalue_derivatives", lambda *a, **k: roots.append(1) or real_roots(*a, **k))
+    monkeypatch.setattr(rows_module, "stacked_eigenvalue_derivatives",
+                        lambda *a, **k: roots.append(len(a[1])) or real_roots(*a, **k))  # a[1]: the stack
     monkeypatch.setattr(rows_module, "_family_rows", lambda *a, **k: members.append(1) or real_members(*a, **k))
     fresh = campaign_problem(config, setup, "exact")
     tracks = len(stability_target(config.stability, setup).tracks)
@@ -235,8 +236,9 @@ def test_values_first_then_the_jacobian_from_the_same_maxima_and_members(tmp_pat
     np.testing.assert_array_equal(values.f, both.f)
     np.testing.assert_array_equal(values.g, both.g)
     again = fresh.evaluate(x, gradient=True)
-    # the Jacobians from the maxima and the members already solved: root derivatives once per speed and track
-    assert len(calls) == 3 and len(maxima) == 3 and len(members) == tracks and len(roots) == tracks * speeds
+    # the Jacobians from the maxima and the members already solved: root derivatives of all speeds in one stacked
+    # call per track
+    assert len(calls) == 3 and len(maxima) == 3 and len(members) == tracks and roots == [speeds] * tracks
     np.testing.assert_array_equal(again.df, both.df)
     np.testing.assert_array_equal(again.dg, both.dg)
     h = 1e-6
