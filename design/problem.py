@@ -70,6 +70,10 @@ class MinimaxProblem:
         The number p of values ``constraints`` returns, when known in advance: ``epsilon`` is checked against it
         here, and every evaluation must return p values (a ``ValueError`` naming ``constraints`` otherwise).
         Without it p is learnt from the first evaluation.
+    batch_functions : callable, optional
+        ``batch_functions(X) -> (B, m)``: f at B designs at once (X of shape (B, d)), the same function as
+        ``functions`` row by row, with a row of +inf where the model refuses a design.  :meth:`values` (objective
+        surfaces, grid scans) uses it; the solvers keep ``functions``.
 
     Raises
     ------
@@ -90,8 +94,12 @@ class MinimaxProblem:
         fd_step: float = 1e-6,
         refine: Callable[[np.ndarray], MinimaxProblem | None] | None = None,
         n_constraints: int | None = None,
+        batch_functions: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> None:
         self.space = Space(variables)
+        if batch_functions is not None and not callable(batch_functions):
+            raise ValueError("batch_functions: must be callable, X (B, d) -> (B, m) array")
+        self._batch_functions = batch_functions
         if refine is not None and not callable(refine):
             raise ValueError("refine: must be callable, x -> MinimaxProblem or None")
         self.refine = refine
@@ -156,7 +164,8 @@ class MinimaxProblem:
         """The same objective subject to other constraints g(x) ≤ ε (conventions as in the constructor); the
         exchange (``refine``) belongs to the constraints it refined and is not carried over."""
         return MinimaxProblem(self.variables, self._functions, self._jacobian, constraints, constraint_jacobian,
-                              epsilon, self.fd_step, n_constraints=n_constraints)
+                              epsilon, self.fd_step, n_constraints=n_constraints,
+                              batch_functions=self._batch_functions)
 
     @property
     def variables(self) -> tuple[DesignVariable, ...]:
@@ -237,6 +246,39 @@ class MinimaxProblem:
     def value(self, x: Sequence[float]) -> float:
         """U(x) = max_k f_k(x) (4.74)."""
         return self.evaluate(x).value
+
+    def values(self, X: Sequence[Sequence[float]] | np.ndarray) -> np.ndarray:
+        """U at each row of X (B, d): shape (B,); +inf where the model refuses a design (a ``ValueError`` of
+        ``functions``) or any f_k is not finite.  One call of ``batch_functions`` when given, else one
+        :meth:`value` per row.
+
+        Raises
+        ------
+        ValueError
+            If X is not (B, d), or ``batch_functions`` returns another shape than (B, m) or NaN.
+        """
+        X = np.asarray(X, dtype=float)
+        if X.ndim != 2 or X.shape[1] != self.space.dim:
+            raise ValueError(f"X: must have shape (B, {self.space.dim}), got {X.shape}")
+        if self._batch_functions is None:
+            out = np.empty(len(X))
+            for b, x in enumerate(X):
+                try:
+                    out[b] = self.value(x)
+                except ValueError:
+                    out[b] = np.inf
+            return out
+        F = np.asarray(self._batch_functions(X), dtype=float)
+        if F.ndim != 2 or F.shape[0] != len(X) or (self.n_functions is not None and F.shape[1] != self.n_functions):
+            raise ValueError(f"batch_functions: must return shape ({len(X)}, m), got {F.shape}")
+        if np.any(np.isnan(F)):
+            raise ValueError("batch_functions: returned NaN (use +inf for a refused design)")
+        return np.where(np.all(np.isfinite(F), axis=1), np.max(F, axis=1), np.inf)
+
+    @property
+    def has_batch(self) -> bool:
+        """True when ``batch_functions`` evaluates many designs in one call."""
+        return self._batch_functions is not None
 
     def constraint_violation(self, x: Sequence[float], evaluation: Evaluation | None = None) -> float:
         """max(0, max_i g_i(x) − ε_i); 0 without constraints."""

@@ -52,34 +52,36 @@ class _Row:
     xi: np.ndarray
     xj_value: float
 
+    batched: bool = False  # fn takes the row's designs (len(xi), d) at once
+
     def __call__(self) -> tuple[float, np.ndarray]:
-        fn, out = resolve(self.fn), []  # fn shipped once per grid (a handle inside a dask task)
-        for v in self.xi:
-            x = self.base.copy()
-            x[self.i], x[self.j] = v, self.xj_value
-            out.append(fn(x))
-        return self.xj_value, np.array(out, dtype=float)
+        fn = resolve(self.fn)  # fn shipped once per grid (a handle inside a dask task)
+        X = np.repeat(self.base[None, :], len(self.xi), axis=0)
+        X[:, self.i], X[:, self.j] = self.xi, self.xj_value
+        if self.batched:
+            return self.xj_value, np.asarray(fn(X), dtype=float)
+        return self.xj_value, np.array([fn(x) for x in X], dtype=float)
 
 
 @dataclass(frozen=True)
-class _Value:
-    """U(x); +inf where the model refuses the design (e.g. a singular model at zero stiffness)."""
+class _Values:
+    """U at a row of designs (B, d); +inf where the model refuses a design (e.g. a singular model at zero
+    stiffness): :meth:`MinimaxProblem.values`, batched when the problem has ``batch_functions``."""
 
     problem: MinimaxProblem
 
-    def __call__(self, x: np.ndarray) -> float:
-        try:
-            return self.problem.value(x)
-        except ValueError:
-            return np.inf
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        return self.problem.values(X)
 
 
 def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], names: tuple[str, str],
              xi: Sequence[float], xj: Sequence[float], base: Sequence[float],
-             client: Runner | None = None, progress: ProgressCallback | None = None) -> np.ndarray:
+             client: Runner | None = None, progress: ProgressCallback | None = None,
+             batched: bool = False) -> np.ndarray:
     """``fn(x)`` on the grid ``xi × xj`` of the two named variables (the others at ``base``), one task per grid
     row: an array (len(xj), len(xi), …) — ``fn`` may return a number or a vector.  ``progress(done, total)``
-    counts finished rows (default: the enclosing :func:`~railopt.design.parallel.reporting_progress`)."""
+    counts finished rows (default: the enclosing :func:`~railopt.design.parallel.reporting_progress`).
+    ``batched``: ``fn`` takes a whole row of designs, shape (len(xi), d), and returns (len(xi), …)."""
     space_names = list(space_names)
     for n in names:
         if n not in space_names:
@@ -94,8 +96,8 @@ def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], nam
     if client is not None:
         check_picklable(fn)  # named from fn's own fields (e.g. problem.functions), not the row task's
     with shipping(client, fn, "fn") as shipped:  # the problem goes to the workers once, not with every row
-        rows = dict(map_unordered(call, [_Row(shipped, base, i, j, xi, float(v)) for v in xj], client=client,
-                                  progress=progress))
+        rows = dict(map_unordered(call, [_Row(shipped, base, i, j, xi, float(v), batched) for v in xj],
+                                  client=client, progress=progress))
     return np.array([rows[float(v)] for v in xj])
 
 
@@ -109,9 +111,10 @@ def objective_surface(
     progress: ProgressCallback | None = None,
 ) -> Surface:
     """U over ``xi × xj`` for the two named variables, the others at ``base``; one task per grid row
-    (``progress(done, total)`` in rows, as :func:`grid_map`)."""
+    (``progress(done, total)`` in rows, as :func:`grid_map`), each row one call of the problem's
+    ``batch_functions`` when it has them (:meth:`MinimaxProblem.values`)."""
     space = problem.space
-    values = grid_map(_Value(problem), space.names, names, xi, xj, base, client, progress)
+    values = grid_map(_Values(problem), space.names, names, xi, xj, base, client, progress, batched=True)
     i, j = space.names.index(names[0]), space.names.index(names[1])
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
     inside_i = (xi >= space.lower[i]) & (xi <= space.upper[i])

@@ -50,3 +50,46 @@ def test_surface_values_and_bounds_mask():
     assert s.minimum(inside_only=False)["U"] == pytest.approx(np.min(np.maximum(A + 2 * B + 0.1, -A)))
     with pytest.raises(ValueError, match="^names:"):
         objective_surface(problem, ("a", "z"), xi, xj, base=[0.5, 0.5, 0.1])
+
+
+def test_a_batched_surface_calls_the_batch_once_per_row_and_equals_the_closed_form():
+    v = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0), DesignVariable("c", 0.0, 1.0)]
+    calls = []
+
+    def point(x):
+        if x[0] < 0:
+            raise ValueError("a: the model refuses a < 0")
+        return np.array([x[0] + 2 * x[1] + x[2], -x[0]])
+
+    def batch(X):
+        calls.append(len(X))
+        F = np.column_stack([X[:, 0] + 2 * X[:, 1] + X[:, 2], -X[:, 0]])
+        F[X[:, 0] < 0] = np.inf  # the refused designs, as the point function's ValueError
+        return F
+
+    xi, xj = np.linspace(-0.5, 1.0, 7), np.linspace(0.0, 2.0, 5)
+    batched = objective_surface(MinimaxProblem(v, point, batch_functions=batch), ("a", "b"), xi, xj, [0.5, 0.5, 0.1])
+    plain = objective_surface(MinimaxProblem(v, point), ("a", "b"), xi, xj, [0.5, 0.5, 0.1])
+    A, B = np.meshgrid(xi, xj)
+    expected = np.where(A < 0, np.inf, np.maximum(A + 2 * B + 0.1, -A))
+    np.testing.assert_array_equal(batched.values, expected)
+    np.testing.assert_array_equal(plain.values, expected)
+    assert calls == [len(xi)] * len(xj)
+
+
+def test_batch_values_refuse_malformed_shapes_and_nan():
+    v = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0)]
+    problem = MinimaxProblem(v, lambda x: x.copy(), batch_functions=lambda X: X[:, :1].T)
+    with pytest.raises(ValueError, match="^batch_functions: must return shape"):
+        problem.values(np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="^X: must have shape"):
+        problem.values(np.zeros(2))
+    nan = MinimaxProblem(v, lambda x: x.copy(), batch_functions=lambda X: np.full_like(X, np.nan))
+    with pytest.raises(ValueError, match="NaN"):
+        nan.values(np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="^batch_functions: must be callable"):
+        MinimaxProblem(v, lambda x: x.copy(), batch_functions=3)
+    constrained = MinimaxProblem(v, lambda x: x.copy(), batch_functions=lambda X: X.copy(),
+                                 constraints=lambda x: x[:1]).with_epsilon(0.5)
+    assert constrained.has_batch
+    np.testing.assert_array_equal(constrained.values([[0.2, 0.7], [0.9, 0.1]]), [0.7, 0.9])
