@@ -45,10 +45,18 @@ def affine(base: np.ndarray, parts: np.ndarray, p: np.ndarray) -> np.ndarray:
     """``base + Σ_i p_i parts[i]``: the one place railopt sums parameter-weighted matrices.
 
     ``base`` (…), ``parts`` (P, …), ``p`` (P,).  Used for M, C, K of every family member and for the
-    input matrices of vehicle views.
+    input matrices of vehicle views.  ``p`` of shape (B, P) gives the B members at once, shape (B, …), each
+    the same sums in the same order as its own (P,) call.
     """
     parts = np.asarray(parts)
     p = np.asarray(p)
+    if p.ndim == 2:
+        if p.shape[1] != len(parts):
+            raise ValueError(f"p: expected {len(parts)} values per member, got {p.shape[1]}")
+        if parts.dtype == object or p.shape[1] == 0:
+            return np.array([affine(base, parts, row) for row in p])
+        weights = p.reshape(p.shape + (1,) * (parts.ndim - 1))
+        return base + (weights * parts[None]).sum(axis=1)
     if len(p) != len(parts):
         raise ValueError(f"p: expected {len(parts)} values, got {len(p)}")
     if parts.dtype == object or len(p) == 0:
@@ -68,6 +76,41 @@ def _family_forcing(F: FamilyForcing | None, n: int, field: str) -> Forcing | Di
             raise ValueError(f"{field}: terms must have n = {n} entries, got {F.n}")
         return F
     return as_forcing(F, n, field)
+
+
+@dataclass(frozen=True)
+class MemberStack:
+    """B members of a family at one speed, stacked (from :meth:`ParametricSystem.stack`).
+
+    Attributes
+    ----------
+    M, C, K : (B, n, n) ndarray
+    delays : (T,) ndarray
+        The forcing's distinct delays (s).
+    coefficients : (B, T, J, n) complex ndarray
+        Member b's forcing is Σ_t Σ_j (iΩ)^j coefficients[b, t, j] e^{−iΩ delays[t]} (:class:`DelayedTerm`).
+    outputs : dict of Output
+        Shared by every member (they do not depend on p).
+    names : tuple of str
+        The degrees of freedom.
+    """
+
+    M: np.ndarray
+    C: np.ndarray
+    K: np.ndarray
+    delays: np.ndarray
+    coefficients: np.ndarray
+    outputs: dict[str, Output]
+    names: tuple[str, ...]
+
+    def __len__(self) -> int:
+        return len(self.M)
+
+    def member(self, b: int) -> LinearSystem:
+        """Member b as a :class:`LinearSystem` (checked like any other)."""
+        forcing = Forcing(terms=[DelayedTerm(float(d), coefficients=self.coefficients[b, t])
+                                 for t, d in enumerate(self.delays)])
+        return LinearSystem(self.M[b], self.C[b], self.K[b], forcing, outputs=self.outputs, names=self.names)
 
 
 class ParametricSystem:
@@ -305,6 +348,33 @@ class ParametricSystem:
         return LinearSystem._trusted(affine(b.M, self._M, p), C, affine(b.K, self._K, p), forcing, outputs,
                                      b.names, tangent)
 
+    def stack(self, P: np.ndarray, speed: float | None = None) -> MemberStack:
+        """The members for the rows of ``P`` (B, P) at one speed, as stacked arrays (no :class:`LinearSystem`
+        per member): what a batch of designs needs for its band maxima or roots in one call.
+
+        Raises
+        ------
+        ValueError
+            If ``P`` is not (B, P) with finite values, or the family's forcing has callable terms (a batch needs
+            the polynomial form, :meth:`at` handles the rest).
+        """
+        P = np.asarray(P, dtype=float)
+        if P.ndim != 2 or P.shape[1] != len(self.parameters) or not np.all(np.isfinite(P)):
+            raise ValueError(f"P: expected a finite (B, {len(self.parameters)}) array, got shape {P.shape}")
+        speed = self._resolve_speed(speed)
+        b = self._base
+        C = affine(b.C, self._C, P)
+        if self._C_speed is not None:
+            C = C + self._C_speed / speed
+        _, _, _, outputs, plan = self._speed_parts(speed)
+        if plan is None:
+            raise ValueError("P: the family's forcing has callable terms; a stack needs polynomial forcing")
+        delays = np.array([d for d, _, _ in plan], dtype=float)
+        coefficients = (np.stack([affine(base, parts, P) for _, base, parts in plan], axis=1) if plan
+                        else np.zeros((len(P), 1, 1, self.n), dtype=complex))
+        return MemberStack(affine(b.M, self._M, P), C, affine(b.K, self._K, P), delays if plan else np.zeros(1),
+                           coefficients, outputs, b.names)
+
     def _speed_derivative(self, p: np.ndarray, speed: float):
         """``Ω -> ∂F/∂S`` at (p, S): the delays d/S and the F_speed/S term of every distance forcing."""
         terms = [(1.0, self._F0)] + [(pi, f) for pi, f in zip(p, self._F, strict=True) if pi != 0.0]
@@ -356,4 +426,4 @@ class ParametricSystem:
         return damped_frequency_jacobian(self.at(p, speed))
 
 
-__all__ = ["FamilyForcing", "ParameterPart", "ParametricSystem", "affine"]
+__all__ = ["FamilyForcing", "MemberStack", "ParameterPart", "ParametricSystem", "affine"]
