@@ -12,7 +12,7 @@ names come from :mod:`railopt.models.mode_names`.  This module never imports the
 from __future__ import annotations
 
 import operator
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -41,8 +41,10 @@ class _SpeedStack:
     ``member`` is the family's member at the first speed (its M, K, tangent and names serve every speed: only the
     creep damping C_speed/S moves with S); ``AB`` (K, n, N) = M⁻¹[K, C(S_k)]; ``G`` (K, N, N) the state matrices
     (4.53); ``s`` (K, N) and ``V`` (K, N, N) their roots and right eigenvectors; ``idx`` (K, n) one root per mode
-    in mode order; ``keep`` (K, n) the kept (vehicle) modes."""
+    in mode order; ``keep`` (K, n) the kept (vehicle) modes; ``speeds`` (K,) m/s.  Iterating gives, speed by speed,
+    ``(S_k, idx[k], keep[k])`` (what the campaign's check of ``exclude`` reads: the last item)."""
 
+    speeds: np.ndarray
     member: LinearSystem
     AB: np.ndarray
     G: np.ndarray
@@ -55,6 +57,9 @@ class _SpeedStack:
     def roots(self) -> np.ndarray:
         """One root per mode (K, n), mode order, 1/s."""
         return np.take_along_axis(self.s, self.idx, axis=1)
+
+    def __iter__(self) -> Iterator[tuple[float, np.ndarray, np.ndarray]]:
+        return zip(self.speeds.tolist(), self.idx, self.keep, strict=True)
 
 
 def _damping_stack(member: LinearSystem, speeds: np.ndarray) -> np.ndarray:
@@ -107,7 +112,7 @@ def _family_rows(family: ParametricSystem, p: Sequence[float] | None, speeds: Se
             name, group = named[j].name, named[j].group
             if any(x == name or x == group or name.startswith(x) for x in exclude):
                 keep[k, j] = False
-    return _SpeedStack(member, AB, G, s, V, idx, keep)
+    return _SpeedStack(speeds, member, AB, G, s, V, idx, keep)
 
 
 class StabilityRows:
@@ -142,6 +147,12 @@ class StabilityRows:
     def mode_roots(self) -> np.ndarray:
         """The roots one per mode at every speed (K, n), complex, 1/s, mode order (dropped modes included)."""
         return self._stack.roots
+
+    @property
+    def kept(self) -> np.ndarray:
+        """The kept (vehicle) modes at every speed (K, n), bool: False for a neutral, track or excluded mode (its
+        rows are the constant −1)."""
+        return self._stack.keep.copy()
 
     def _root_derivatives(self, wrt: Sequence[int] | None) -> np.ndarray:
         """ds/dp (K, n, len(wrt) or P) of the roots one per mode, all speeds in one stacked call."""

@@ -69,6 +69,7 @@ def check_rows(family: ParametricSystem, speeds: list[float], defective_tol: flo
         assert not np.any(kept[k] & ~live[k])  # a neutral (rigid-body) root is a dropped row
         assert np.sum(live[k] & ~kept[k]) == track_modes
     assert np.all(ds[~kept] == 0.0)  # a dropped row has a zero gradient
+    np.testing.assert_array_equal(rows.kept, kept)
     for i in range(len(p)):
         h = FD_STEP * abs(p[i])
         up, down = p.copy(), p.copy()
