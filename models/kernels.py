@@ -2,6 +2,8 @@
 
 What lives here, each written once:
 
+- :func:`member_state` (M⁻¹[K C] with the regularity check of M), :func:`left_vectors` (W = V⁻¹ and cond₁(V)),
+  :func:`residues` (the pole–residue coefficients) and :func:`direct_solutions` (``Z(Ω)X = F`` at many Ω);
 - :func:`band_grid` — the frequency grid of the exact method (per-pole ``Ω = ω_k + σ_k sinh(u)`` points, a uniform
   floor/delay grid, bisection of any step that breaks ``step ≤ GRID_FACTOR·dist(iΩ, poles)``);
 - :func:`pole_residue_sums` / :func:`pole_residue_magnitudes` — the pole–residue sum
@@ -47,6 +49,15 @@ _A, _B, _X, _W, _V, _FX, _FW, _FV, _D, _E, _TOL, _U, _NE, _DONE = range(14)
 _VX, _VLO, _VHI, _VTOL, _VH, _VREF, _VOK = range(7)
 
 
+def c_array(a: object, dtype: type = float) -> np.ndarray:
+    """``a`` as a writeable C-contiguous array of ``dtype`` (float64 or complex128), copied only when needed: the
+    kernels' one compiled signature per argument (a read-only or strided array would compile a second one)."""
+    arr = np.asarray(a, dtype=dtype)
+    if arr.flags.c_contiguous and arr.flags.writeable:
+        return arr
+    return np.array(arr, dtype=dtype, order="C")
+
+
 def dual(function):
     """Make ``function`` callable from compiled code too (numba compiles its own source for a compiled caller)."""
     @functools.wraps(function)  # the typing function must show the implementation's signature
@@ -55,6 +66,99 @@ def dual(function):
 
     overload(function, jit_options={"error_model": "numpy", "nogil": True})(typer)
     return function
+
+
+# ---------------------------------------------------------------------------------------------------- member, modes
+@njit(**JIT)
+def member_state(M: np.ndarray, K: np.ndarray, C: np.ndarray, singular_pivot: float) -> tuple[np.ndarray, bool]:
+    """M⁻¹[K C] (n, 2n) of the state matrix G = [[0, I], [−M⁻¹K, −M⁻¹C]] (thesis eq. 4.53), and whether M is
+    regular: its partial-pivot LU (LAPACK getrf's pivot rule) has every |pivot| > ``singular_pivot``·max|pivot|.
+    The solve is LAPACK gesv (numpy's ``solve``); a singular M returns zeros and False."""
+    n = M.shape[0]
+    LU = M.copy()
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(LU[i, k]) > abs(LU[p, k]):
+                p = i
+        if p != k:
+            for j in range(n):
+                LU[k, j], LU[p, j] = LU[p, j], LU[k, j]
+        if LU[k, k] != 0.0:
+            for i in range(k + 1, n):
+                LU[i, k] /= LU[k, k]
+                for j in range(k + 1, n):
+                    LU[i, j] -= LU[i, k] * LU[k, j]
+    pmax, pmin = 0.0, math.inf
+    for i in range(n):
+        pmax, pmin = max(pmax, abs(LU[i, i])), min(pmin, abs(LU[i, i]))
+    if n and not pmin > singular_pivot * max(pmax, 1e-300):
+        return np.zeros((n, 2 * n)), False
+    KC = np.empty((n, 2 * n))
+    KC[:, :n] = K
+    KC[:, n:] = C
+    return np.ascontiguousarray(np.linalg.solve(M, KC)), True
+
+
+@njit(**JIT)
+def left_vectors(V: np.ndarray) -> tuple[np.ndarray, float]:
+    """W = V⁻¹ (LAPACK gesv on V W = I) and cond₁(V) = ‖V‖₁‖W‖₁ (inf when it overflows); raises numpy's
+    ``LinAlgError`` when V is exactly singular."""
+    N = V.shape[0]
+    W = np.ascontiguousarray(np.linalg.solve(V, np.eye(N, dtype=np.complex128)))  # LAPACK gives Fortran order
+    nv, nw = 0.0, 0.0
+    for j in range(N):
+        a, b = 0.0, 0.0
+        for i in range(N):
+            a += abs(V[i, j])
+            b += abs(W[i, j])
+        nv, nw = max(nv, a), max(nw, b)
+    cond = nv * nw
+    return W, cond if math.isfinite(cond) else math.inf
+
+
+@njit(**JIT)
+def residues(M: np.ndarray, V: np.ndarray, W: np.ndarray, rows: np.ndarray, A: np.ndarray) -> tuple[np.ndarray,
+                                                                                                     np.ndarray]:
+    """Residues R[k, o, t, j] = (c_o·V_x[:, k]) (W_v M⁻¹ A_tj)_k (thesis eqs. 4.53–4.58) and B = W_v M⁻¹ (2n, n).
+
+    M (n, n) real; V, W (2n, 2n) complex; rows (m, n) real output rows; A (T, J, n) complex forcing coefficients.
+    """
+    n = M.shape[0]
+    N = V.shape[0]
+    Wv = np.ascontiguousarray(W[:, n:])
+    B = np.ascontiguousarray(np.linalg.solve(np.ascontiguousarray(M.T).astype(np.complex128),
+                                             np.ascontiguousarray(Wv.T)).T)
+    T, J, m = A.shape[0], A.shape[1], rows.shape[0]
+    R = np.zeros((N, m, T, J), np.complex128)
+    for k in range(N):
+        for o in range(m):
+            cv = 0j
+            for i in range(n):
+                cv += rows[o, i] * V[i, k]
+            for t in range(T):
+                for j in range(J):
+                    ba = 0j
+                    for i in range(n):
+                        ba += B[k, i] * A[t, j, i]
+                    R[k, o, t, j] = cv * ba
+    return R, B
+
+
+@njit(**JIT)
+def direct_solutions(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """X (N, n): Z(Ω)X = F(Ω) with Z = K − Ω²M + iΩC (thesis eqs. 4.69–4.70) at each Ω of ``w`` (N,), F (N, n)
+    complex; LAPACK gesv per frequency (numpy's ``LinAlgError`` when a Z is exactly singular)."""
+    n = M.shape[0]
+    X = np.empty((w.size, n), np.complex128)
+    Z = np.empty((n, n), np.complex128)
+    for t in range(w.size):
+        x = w[t]
+        for i in range(n):
+            for j in range(n):
+                Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
+        X[t] = np.linalg.solve(Z, np.ascontiguousarray(F[t]))
+    return X
 
 
 # ---------------------------------------------------------------------------------------------------- band grid
@@ -585,9 +689,10 @@ def cell_maxima_pole_residue(grid: np.ndarray, values: np.ndarray, bounds: np.nd
 
 
 __all__ = [
-    "BRACKET_RTOL", "CANDIDATE_MARGIN", "INV_PHI", "MAX_ITERATIONS", "VERTEX_ITERATIONS", "all_positive",
+    "BRACKET_RTOL", "CANDIDATE_MARGIN", "INV_PHI", "MAX_ITERATIONS", "VERTEX_ITERATIONS", "all_positive", "c_array",
     "band_grid", "brent_accept", "brent_points", "brent_propose", "brent_run", "brent_set_start", "brent_start",
-    "cell_candidates", "cell_maxima_pole_residue", "cell_select", "drop_falling_edges", "dual", "edge_probes",
-    "log_or_value", "magnitudes", "pole_residue_magnitudes", "pole_residue_sums", "refine_cells", "take_better",
+    "cell_candidates", "cell_maxima_pole_residue", "cell_select", "direct_solutions", "drop_falling_edges", "dual",
+    "edge_probes", "left_vectors", "log_or_value", "magnitudes", "member_state", "pole_residue_magnitudes",
+    "pole_residue_sums", "refine_cells", "residues", "take_better",
     "vertex_points", "vertex_run", "vertex_start", "vertex_update",
 ]

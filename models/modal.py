@@ -14,6 +14,7 @@ from functools import cached_property
 
 import numpy as np
 
+from railopt.models.kernels import c_array, left_vectors
 from railopt.records import ArrayRecord
 
 UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
@@ -37,14 +38,10 @@ class Modal(ArrayRecord):
 
     @cached_property
     def _left(self) -> tuple[np.ndarray, float]:
-        try:
-            W = np.linalg.solve(self.V, np.eye(self.V.shape[0]))
-            with np.errstate(over="ignore"):  # an overflowing product is the inf condition below
-                condition = float(np.linalg.norm(self.V, 1) * np.linalg.norm(W, 1))
+        try:  # the compiled W = V⁻¹ and cond₁(V) (inf when the product overflows)
+            W, condition = left_vectors(c_array(self.V, complex))
         except np.linalg.LinAlgError:
-            W = np.full_like(self.V, np.nan)
-            condition = float("inf")
-        if not np.isfinite(condition):
+            W = np.full(self.V.shape, np.nan, dtype=complex)
             condition = float("inf")
         W.setflags(write=False)
         return W, condition

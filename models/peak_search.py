@@ -25,8 +25,7 @@ SCALAR_CELLS = 12  # kept for compatibility: every cell is refined by the one Br
 
 
 def _floats(a: object) -> np.ndarray:
-    """C-contiguous float64 copy of ``a`` (1-D): the kernels' one signature."""
-    return np.ascontiguousarray(np.asarray(a, dtype=float).ravel())
+    return kernels.c_array(np.ravel(a))
 
 
 def bracketed_maximum(fun: Callable[[np.ndarray], np.ndarray], lower: np.ndarray, upper: np.ndarray,

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from railopt.models.forcing import Forcing
-from railopt.models.kernels import pole_residue_magnitudes, pole_residue_sums
+from railopt.models.kernels import c_array, pole_residue_magnitudes, pole_residue_sums, residues
 from railopt.models.modal import Modal
 
 
@@ -31,24 +31,21 @@ class PoleResidue:
 
     def __init__(self, M: np.ndarray, decomposition: Modal, rows: np.ndarray, orders: np.ndarray,
                  forcing: Forcing, feedthroughs: list[Forcing | None] | None = None) -> None:
-        n = M.shape[0]
         self._feedthroughs = list(feedthroughs or [None] * rows.shape[0])
         self.poles = np.array(decomposition.s, dtype=complex)  # a writeable C copy: the kernels' one signature
         self.orders = np.asarray(orders)
-        V, W = decomposition.V, decomposition.W
-        self._B = np.linalg.solve(M.T, W[:, n:].T).T  # W_v M⁻¹, (2n, n)
-        self._Cv = rows @ V[:n]  # (m, 2n)
+        V = c_array(decomposition.V, complex)
         poly = [t for t in forcing.terms if t.coefficients is not None]
         self._callables = [t for t in forcing.terms if t.coefficients is None]
         self._delays = np.array([t.delay for t in poly], dtype=float)
         degree = max((t.coefficients.shape[0] for t in poly), default=1)
-        # R[k, o, t, j] = Cv[o, k] · (B A_tj)[k]: every term's coefficients stacked, one product
-        A = np.zeros((len(poly), degree, n), dtype=complex)
+        A = np.zeros((len(poly), degree, M.shape[0]), dtype=complex)  # every term's coefficients stacked
         for ti, t in enumerate(poly):
             A[ti, : t.coefficients.shape[0]] = t.coefficients
-        BA = self._B @ A.reshape(len(poly) * degree, n).T  # (2n, T·J)
-        self._R = np.ascontiguousarray(
-            (self._Cv.T[:, :, None] * BA[:, None, :]).reshape(len(self.poles), rows.shape[0], len(poly), degree))
+        # R[k, o, t, j] = (c_o·V_x[:, k]) (W_v M⁻¹ A_tj)_k; B = W_v M⁻¹ (2n, n) serves the callable terms
+        self._R, self._B = residues(c_array(M), V, c_array(decomposition.W, complex), c_array(rows), A)
+        self._Cv = rows @ V[: M.shape[0]]  # (m, 2n)
+
 
     def kernel_data(self, output: int) -> tuple | None:
         """``(poles, R, output, delays, q)`` for the compiled |H_output| of
@@ -97,7 +94,7 @@ class PoleResidue:
 
 
 def _floats(a: object) -> np.ndarray:
-    return np.ascontiguousarray(np.asarray(a, dtype=float).ravel())
+    return c_array(np.ravel(a))
 
 
 __all__ = ["PoleResidue"]

@@ -413,7 +413,7 @@ def _exact_cells(system: LinearSystem, pr, grid: np.ndarray, bounds: np.ndarray,
     for i, c in enumerate(cols):  # per output (usually one); the cells of each are refined all at once
         data = pr.kernel_data(c) if pr is not None else None
         if data is not None:  # the compiled search with the pole–residue |H| inline
-            x, f, _ = kernels.cell_maxima_pole_residue(grid, np.ascontiguousarray(mags[:, i]), bounds,
+            x, f, _ = kernels.cell_maxima_pole_residue(grid, kernels.c_array(mags[:, i]), bounds,
                                                        BRACKET_RTOL, *data)
         else:
             fun = pr.magnitude_function(c) if pr is not None else (
@@ -464,14 +464,16 @@ def _direct(system: LinearSystem, w: np.ndarray, cols: list[int]) -> np.ndarray:
     forcing = system.forcing
     if not forcing.is_polynomial:
         return system.frf_outputs(omega_rad_s=w)[:, cols]
-    w = np.asarray(w, dtype=float).ravel()
+    w = kernels.c_array(np.ravel(w))
     F = forcing.values(w)
-    with np.errstate(over="ignore", invalid="ignore"):
-        Z = (system.K[None] - w[:, None, None] ** 2 * system.M[None]) + 1j * w[:, None, None] * system.C[None]
-    if not (np.isfinite(F).all() and np.isfinite(Z).all()):
+    with np.errstate(over="ignore", invalid="ignore"):  # a bound on |Z(Ω)|: beyond it an entry may overflow
+        bound = np.max(w**2, initial=0.0) * np.max(np.abs(system.M)) + np.max(np.abs(w), initial=0.0) * np.max(
+            np.abs(system.C)) + np.max(np.abs(system.K))
+    if not (np.isfinite(F).all() and np.isfinite(bound)):
         return system.frf_outputs(omega_rad_s=w)[:, cols]
     try:
-        X = np.linalg.solve(Z, F[..., None])[..., 0]
+        X = kernels.direct_solutions(kernels.c_array(system.M), kernels.c_array(system.C),
+                                     kernels.c_array(system.K), w, kernels.c_array(F, complex))
     except np.linalg.LinAlgError:
         return system.frf_outputs(omega_rad_s=w)[:, cols]
     outputs = list(system.outputs.values())
@@ -507,7 +509,7 @@ def band_grid(poles: np.ndarray, band: tuple[float, float], max_delay: float = 0
     """
     lo, hi = float(band[0]), float(band[1])
     count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points((lo, hi), max_delay), MAX_GRID_POINTS))
-    extra = np.zeros(0) if extra is None else np.ascontiguousarray(np.asarray(extra, dtype=float).ravel())
-    grid, ratio = kernels.band_grid(np.ascontiguousarray(np.asarray(poles, dtype=complex).ravel()), lo, hi,
+    extra = np.zeros(0) if extra is None else kernels.c_array(np.ravel(extra))
+    grid, ratio = kernels.band_grid(kernels.c_array(np.ravel(poles), complex), lo, hi,
                                     float(max_delay), extra, int(count), GRID_FACTOR, POLE_STEP, MAX_GRID_POINTS)
     return grid, float(ratio)

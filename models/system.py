@@ -20,6 +20,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from railopt.models.forcing import Forcing, ForcingLike, as_forcing
+from railopt.models.kernels import c_array, direct_solutions, member_state
 from railopt.models.modal import CONDITION_LIMIT, UNDAMPED_ROOT, Modal, modal, mode_order
 from railopt.models.pole_residue import PoleResidue
 from railopt.models.validation import frequencies_arg, real_array, square_matrix
@@ -134,14 +135,9 @@ class LinearSystem:
 
     def _prepare(self) -> None:
         """M⁻¹[K C] for the state matrix (4.53); a singular M is an error naming the field."""
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", sla.LinAlgWarning)
-            lu = sla.lu_factor(self.M, check_finite=False)
-        piv = np.abs(np.diag(lu[0]))
-        if np.min(piv) <= 1e-14 * max(np.max(piv), 1e-300):
+        self._minv_kc, regular = member_state(c_array(self.M), c_array(self.K), c_array(self.C), 1e-14)
+        if not regular:
             raise ValueError("M: is singular (a coordinate without inertia); eliminate it first")
-        # numpy's solve: scipy's lu_solve pays a large fixed cost per call on small matrices here
-        self._minv_kc = np.linalg.solve(self.M, np.hstack([self.K, self.C]))
         self._eigvals: np.ndarray | None = None
         self._modal: Modal | None = None
         self._pole_residue: PoleResidue | None | bool = False  # False: not built yet
@@ -303,7 +299,7 @@ class LinearSystem:
             raise ValueError(f"omega: Z(Ω) = K − Ω²M + iΩC overflows at {bad[:3].tolist()} rad/s; "
                              "no response can be computed there")
         try:
-            X = np.linalg.solve(Z, F[..., None])[..., 0]
+            X = direct_solutions(c_array(self.M), c_array(self.C), c_array(self.K), c_array(w), c_array(F, complex))
         except np.linalg.LinAlgError:  # a singular Z somewhere: point by point with pivot checks
             X = self.solve_many(w)
         rows = np.array([o.row for o in self.outputs.values()])

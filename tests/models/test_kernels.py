@@ -21,7 +21,7 @@ def chain(n: int, seed: int, terms: int = 2, max_delay: float = 0.7) -> tuple:
     A = np.array([t.coefficients for t in sys.forcing.terms])
     delays = np.array([t.delay for t in sys.forcing.terms])
     rows = np.array([np.random.default_rng(seed + 100).standard_normal(n), sys.output])
-    return sys.M, sys.C, sys.K, A, delays, rows, np.array([1, 2])
+    return np.array(sys.M), np.array(sys.C), np.array(sys.K), A, delays, rows, np.array([1, 2])
 
 
 def direct_frf(M, C, K, A, delays, rows, q, w):
@@ -199,6 +199,51 @@ def test_each_kernel_keeps_one_compiled_signature():
     response_maxima(sys, band_rad_s=(0.0, 3.0), exact=True)
     x = np.arange(10.0)[::2]
     cell_maxima(np.cos, x, np.cos(x), np.array([0.0, 8.0]))
+    sys.frf(omega_rad_s=[1, 2])
     for kernel in (kernels.band_grid, kernels.pole_residue_magnitudes, kernels.cell_maxima_pole_residue,
-                   kernels.pole_residue_sums, kernels.vertex_start, kernels.brent_start):
+                   kernels.pole_residue_sums, kernels.vertex_start, kernels.brent_start, kernels.member_state,
+                   kernels.left_vectors, kernels.residues, kernels.direct_solutions):
         assert len(kernel.signatures) <= 1, kernel
+
+
+def test_member_state_and_left_vectors_against_scipy():
+    """M⁻¹[K C] against scipy.linalg.solve, a singular M refused by the pivot rule (ValueError naming M);
+    W = V⁻¹ against scipy.linalg.inv and cond₁(V) against numpy's cond(V, 1)."""
+    import scipy.linalg as sla
+
+    M, C, K, *_ = chain(5, seed=4)
+    minv_kc, regular = kernels.member_state(M, K, C, 1e-14)
+    assert regular
+    np.testing.assert_allclose(minv_kc, sla.solve(M, np.hstack([K, C])), rtol=1e-14, atol=1e-14 * np.abs(K).max())
+    singular = M.copy()
+    singular[2] = 0.0
+    assert not kernels.member_state(singular, K, C, 1e-14)[1]
+    with pytest.raises(ValueError, match="M: is singular"):
+        LinearSystem(singular, C, K, np.ones(5), np.ones(5))
+    G = np.block([[np.zeros((5, 5)), np.eye(5)], [-minv_kc[:, :5], -minv_kc[:, 5:]]])
+    _, V = np.linalg.eig(G)
+    W, cond = kernels.left_vectors(np.ascontiguousarray(V))
+    np.testing.assert_allclose(W, sla.inv(V), rtol=1e-12, atol=1e-12 * np.abs(W).max())
+    assert abs(cond - np.linalg.cond(V, 1)) <= 1e-12 * cond
+
+
+def test_compiled_residues_and_direct_solutions_equal_dense_solves():
+    """The compiled residues summed by the compiled pole–residue kernel, and the compiled batched solves, both
+    equal the dense direct solve of this file to 1e-12 relative (polynomial delayed forcing, two outputs)."""
+    M, C, K, A, delays, rows, q = chain(4, seed=5)
+    s, _ = residues(M, C, K, A, rows)  # numpy's eig: the roots and vectors are inputs here
+    n = M.shape[0]
+    G = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    s, V = np.linalg.eig(G)
+    V = np.ascontiguousarray(V)
+    W, _ = kernels.left_vectors(V)
+    R, _ = kernels.residues(M, V, W, rows, np.ascontiguousarray(A))
+    w = np.linspace(0.1, 3.5, 157)
+    ref = direct_frf(M, C, K, A, delays, rows, q, w)
+    H = kernels.pole_residue_sums(w, np.ascontiguousarray(s), R, np.array([0, 1], dtype=np.int64), delays)
+    H *= (1j * w[:, None]) ** q[None, :]
+    assert np.max(np.abs(H - ref) / np.abs(ref)) < 1e-12
+    F = np.einsum("nt,tjk,nj->nk", np.exp(-1j * np.outer(w, delays)), A, (1j * w[:, None]) ** np.arange(2))
+    X = kernels.direct_solutions(M, C, K, w, np.ascontiguousarray(F))
+    Hd = (X @ rows.T) * (1j * w[:, None]) ** q[None, :]
+    assert np.max(np.abs(Hd - ref) / np.abs(ref)) < 1e-13
