@@ -12,7 +12,7 @@ names come from :mod:`railopt.models.mode_names`.  This module never imports the
 from __future__ import annotations
 
 import operator
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -41,8 +41,7 @@ class _SpeedStack:
     ``member`` is the family's member at the first speed (its M, K, tangent and names serve every speed: only the
     creep damping C_speed/S moves with S); ``AB`` (K, n, N) = M⁻¹[K, C(S_k)]; ``G`` (K, N, N) the state matrices
     (4.53); ``s`` (K, N) and ``V`` (K, N, N) their roots and right eigenvectors; ``idx`` (K, n) one root per mode
-    in mode order; ``keep`` (K, n) the kept (vehicle) modes; ``speeds`` (K,) m/s.  Iterating gives, speed by speed,
-    ``(S_k, idx[k], keep[k])`` (what the campaign's check of ``exclude`` reads: the last item)."""
+    in mode order; ``keep`` (K, n) the kept (vehicle) modes; ``speeds`` (K,) m/s."""
 
     speeds: np.ndarray
     member: LinearSystem
@@ -57,9 +56,6 @@ class _SpeedStack:
     def roots(self) -> np.ndarray:
         """One root per mode (K, n), mode order, 1/s."""
         return np.take_along_axis(self.s, self.idx, axis=1)
-
-    def __iter__(self) -> Iterator[tuple[float, np.ndarray, np.ndarray]]:
-        return zip(self.speeds.tolist(), self.idx, self.keep, strict=True)
 
 
 def _damping_stack(member: LinearSystem, speeds: np.ndarray) -> np.ndarray:

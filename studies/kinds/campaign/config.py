@@ -418,22 +418,21 @@ def _check_stability(cfg: CampaignStudyConfig, setup: ModelSetup, where: str) ->
 def _check_exclude(spec, families: dict, required: float, where: str) -> None:
     """Each ``exclude`` entry must leave out some mode of the existing design at a row speed on some track, and the
     entries together must keep at least one mode at every row speed on every track (by the rows' own rule,
-    :func:`railopt.models.stability_rows._family_rows`); an unknown name gets a did-you-mean among the modes'
+    :attr:`railopt.models.stability_rows.StabilityRows.kept`); an unknown name gets a did-you-mean among the modes'
     names and groups."""
     if not spec.exclude:
         return
     from railopt.models.stability import modes
-    from railopt.models.stability_rows import _family_rows
+    from railopt.models.stability_rows import StabilityRows
 
     speeds = spec.grid(required)
     matched = [False] * len(spec.exclude)
     names: set[str] = set()
     for track, family in families.items():
-        kept = [keep for *_, keep in _family_rows(family, None, speeds, ())]
+        kept = StabilityRows(family, None, speeds, ()).kept  # (speeds, modes)
         for i, entry in enumerate(spec.exclude):
-            rows = [keep for *_, keep in _family_rows(family, None, speeds, [entry])]
-            matched[i] |= any(bool((a != b).any()) for a, b in zip(kept, rows, strict=True))
-        left = [keep for *_, keep in _family_rows(family, None, speeds, spec.exclude)]
+            matched[i] |= bool((StabilityRows(family, None, speeds, [entry]).kept != kept).any())
+        left = StabilityRows(family, None, speeds, spec.exclude).kept
         for speed, keep in zip(speeds, left, strict=True):
             if not keep.any():
                 raise ValueError(f"stability.exclude: {spec.exclude} leaves out every mode of {where} on {track} track "
