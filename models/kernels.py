@@ -146,19 +146,28 @@ def residues(M: np.ndarray, V: np.ndarray, W: np.ndarray, rows: np.ndarray, A: n
 
 
 @njit(**JIT)
-def direct_solutions(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: np.ndarray, F: np.ndarray) -> np.ndarray:
+def direct_solutions(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: np.ndarray,
+                     F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """X (N, n): Z(Ω)X = F(Ω) with Z = K − Ω²M + iΩC (thesis eqs. 4.69–4.70) at each Ω of ``w`` (N,), F (N, n)
-    complex; LAPACK gesv per frequency (numpy's ``LinAlgError`` when a Z is exactly singular)."""
+    complex; LAPACK gesv per frequency (numpy's ``LinAlgError`` when a Z is exactly singular).  Also ``overflow``
+    (N,) bool: Z(Ω) has a non-finite entry there; when any has, nothing is solved (X is NaN)."""
     n = M.shape[0]
-    X = np.empty((w.size, n), np.complex128)
+    X = np.full((w.size, n), complex(math.nan, math.nan))
+    overflow = np.zeros(w.size, np.bool_)
     Z = np.empty((n, n), np.complex128)
-    for t in range(w.size):
-        x = w[t]
-        for i in range(n):
-            for j in range(n):
-                Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
-        X[t] = np.linalg.solve(Z, np.ascontiguousarray(F[t]))
-    return X
+    for solve in (False, True):  # first every Z is checked, then (none overflowing) solved
+        for t in range(w.size):
+            x = w[t]
+            for i in range(n):
+                for j in range(n):
+                    Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
+                    if not (math.isfinite(Z[i, j].real) and math.isfinite(Z[i, j].imag)):
+                        overflow[t] = True
+            if solve:
+                X[t] = np.linalg.solve(Z, np.ascontiguousarray(F[t]))
+        if overflow.any():
+            break
+    return X, overflow
 
 
 # ---------------------------------------------------------------------------------------------------- band grid

@@ -292,16 +292,14 @@ class LinearSystem:
         self._out(None)  # a system without outputs has no response
         w = frequencies_arg(omega, frequencies_hz, omega_rad_s)
         F = np.array([self.forcing_at(float(x)) for x in w], dtype=complex).reshape(len(w), self.n)
-        with np.errstate(over="ignore", invalid="ignore"):
-            Z = (self.K[None] - w[:, None, None] ** 2 * self.M[None]) + 1j * w[:, None, None] * self.C[None]
-        if not np.all(np.isfinite(Z)):
-            bad = w[~np.all(np.isfinite(Z), axis=(1, 2))]
-            raise ValueError(f"omega: Z(Ω) = K − Ω²M + iΩC overflows at {bad[:3].tolist()} rad/s; "
-                             "no response can be computed there")
         try:
-            X = direct_solutions(c_array(self.M), c_array(self.C), c_array(self.K), c_array(w), c_array(F, complex))
+            X, overflow = direct_solutions(c_array(self.M), c_array(self.C), c_array(self.K), c_array(w),
+                                           c_array(F, complex))
         except np.linalg.LinAlgError:  # a singular Z somewhere: point by point with pivot checks
-            X = self.solve_many(w)
+            X, overflow = self.solve_many(w), np.zeros(len(w), dtype=bool)
+        if overflow.any():
+            raise ValueError(f"omega: Z(Ω) = K − Ω²M + iΩC overflows at {w[overflow][:3].tolist()} rad/s; "
+                             "no response can be computed there")
         rows = np.array([o.row for o in self.outputs.values()])
         orders = np.array([o.order for o in self.outputs.values()])
         with np.errstate(over="ignore", invalid="ignore"):

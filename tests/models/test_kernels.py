@@ -244,6 +244,16 @@ def test_compiled_residues_and_direct_solutions_equal_dense_solves():
     H *= (1j * w[:, None]) ** q[None, :]
     assert np.max(np.abs(H - ref) / np.abs(ref)) < 1e-12
     F = np.einsum("nt,tjk,nj->nk", np.exp(-1j * np.outer(w, delays)), A, (1j * w[:, None]) ** np.arange(2))
-    X = kernels.direct_solutions(M, C, K, w, np.ascontiguousarray(F))
+    X, overflow = kernels.direct_solutions(M, C, K, w, np.ascontiguousarray(F))
     Hd = (X @ rows.T) * (1j * w[:, None]) ** q[None, :]
-    assert np.max(np.abs(Hd - ref) / np.abs(ref)) < 1e-13
+    assert np.max(np.abs(Hd - ref) / np.abs(ref)) < 1e-13 and not overflow.any()
+    # Ω² M overflows at 1e160 rad/s: that row is flagged, not solved
+    _, overflow = kernels.direct_solutions(M, C, K, np.array([1.0, 1e160]), np.ascontiguousarray(F[:2]))
+    assert overflow.tolist() == [False, True]
+
+
+def test_an_overflowing_impedance_is_named():
+    """Ω² M overflows at Ω = 1e160 rad/s: an error naming omega, never a silent number."""
+    sys = LinearSystem(np.eye(2), 0.1 * np.eye(2), np.array([[2.0, -1.0], [-1.0, 2.0]]), [1.0, 0.0], [0.0, 1.0])
+    with pytest.raises(ValueError, match="omega: Z"):
+        sys.frf(omega_rad_s=np.array([1.0, 1e160]))
