@@ -20,9 +20,11 @@ the quadratic through the partials at ε, 2ε and 4ε, so the derivative is that
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from functools import partial
 
 import numpy as np
 
+from railopt.models.forcing import DelayedTerm, Forcing
 from railopt.models.modal import NEUTRAL_ROOT, mode_order
 from railopt.models.response_maxima import ResponseMaxima, ZeroZone, all_response_maxima, zero_zone
 from railopt.models.system import LinearSystem, Tangent
@@ -150,48 +152,140 @@ def damped_frequency_jacobian(system: LinearSystem) -> np.ndarray:
     return np.where(s[idx].imag[:, None] == 0.0, 0.0, np.sign(s[idx].imag)[:, None] * ds.imag)
 
 
-def _partials(system: LinearSystem, omega: float, cols: list[int]) -> tuple[np.ndarray, ...]:
-    """H (m,), ∂H/∂p (m, P), ∂H/∂Ω (m,) at one frequency for the output columns ``cols``."""
+_TANGENT_FORCINGS: dict[tuple[int, ...], tuple[tuple[Forcing | None, ...], Forcing | None]] = {}
+
+
+def _tangent_forcing(t: Tangent, n: int) -> Forcing | None:
+    """``∂F/∂p_i`` of all P parameters as one :class:`~railopt.models.forcing.Forcing` of P·n components
+    (parameter i in components ``i·n … i·n + n − 1``), so ``values(Ω)`` (K, P·n) evaluates every column at every
+    frequency in one call; None when F depends on no parameter.  Cached on the identity of the ∂F/∂p_i (a family
+    hands every member at one speed the same objects); the cache holds them, so a reused id is never mistaken."""
+    key = tuple(id(f) for f in t.dF)
+    held = _TANGENT_FORCINGS.get(key)
+    if held is not None and all(a is b for a, b in zip(held[0], t.dF, strict=True)):
+        return held[1]
+    P = len(t.dF)
+    blocks: dict[float, np.ndarray] = {}  # delay -> (J, P·n) polynomial coefficients
+    others: list[DelayedTerm] = []
+    for i, f in enumerate(t.dF):
+        for term in (f.terms if f is not None else ()):
+            if term.coefficients is None:  # a callable term: its values placed in parameter i's components
+                others.append(DelayedTerm(term.delay, function=partial(_embedded, term.function, i, P, n)))
+                continue
+            c = term.coefficients
+            acc = blocks.get(term.delay)
+            if acc is None or acc.shape[0] < c.shape[0]:
+                grown = np.zeros((c.shape[0], P * n), dtype=complex)
+                if acc is not None:
+                    grown[: acc.shape[0]] = acc
+                acc = blocks[term.delay] = grown
+            acc[: c.shape[0], i * n:(i + 1) * n] += c
+    terms = [DelayedTerm(d, coefficients=c) for d, c in blocks.items()] + others
+    stacked = Forcing(terms=terms) if terms else None
+    if len(_TANGENT_FORCINGS) > 64:
+        _TANGENT_FORCINGS.clear()
+    _TANGENT_FORCINGS[key] = (t.dF, stacked)
+    return stacked
+
+
+def _embedded(function, i: int, P: int, n: int, omega: float) -> np.ndarray:
+    """A callable term ``function(Ω)`` (n,) of parameter i placed in components ``i·n … i·n + n − 1`` of P·n."""
+    out = np.zeros(P * n, dtype=complex)
+    out[i * n:(i + 1) * n] = function(omega)
+    return out
+
+
+def _impedances(system: LinearSystem, omega: np.ndarray) -> np.ndarray:
+    """``Z(Ω_k) = K − Ω_k²M + iΩ_kC`` (K, n, n) of thesis eq. (4.69) at the frequencies ``omega`` (K,)."""
+    return system.K[None] - omega[:, None, None] ** 2 * system.M[None] + 1j * omega[:, None, None] * system.C[None]
+
+
+def _partials(system: LinearSystem, omega: np.ndarray, cols: np.ndarray,
+              slope: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """H (K,), ∂H/∂p (K, P) and ∂H/∂Ω (K,) of output ``cols[k]`` at frequency ``omega[k]``, all K at once.
+
+    One stacked solve ``Z(Ω_k) X_k = F(Ω_k)`` and one stacked adjoint solve ``Z(Ω_k)ᵀ w_k = c_k``; then
+    ``∂H/∂p_i = (iΩ)^q w_kᵀ(F_i − Z_i X_k)`` with ``Z_i = K_i − Ω²M_i + iΩC_i``, the parameter contractions
+    ``w_kᵀ Z_i X_k`` as one product of the outer products ``w_k X_kᵀ`` (K, n²) with the stacked ``(K_i, M_i, C_i)``
+    (n², 3P).  ∂H/∂Ω only where ``slope[k]`` (elsewhere 0: its factor dΩ/dp is 0).  Raises
+    ``numpy.linalg.LinAlgError`` if any Z(Ω_k) is exactly singular."""
     t = _tangent(system)
-    outs = [list(system.outputs.values())[c] for c in cols]
-    rows = np.array([o.row for o in outs], dtype=complex)
-    q = np.array([o.order for o in outs])
-    Z = system.impedance(omega)
-    F = system.forcing_at(omega)
-    X = np.linalg.solve(Z, F)
-    w = np.linalg.solve(Z.T, rows.T).T  # (m, n) adjoints: Zᵀ w = c
+    n, P, K = system.n, len(t.parameters), len(omega)
+    outs = list(system.outputs.values())
+    rows = np.array([outs[c].row for c in cols], dtype=complex).reshape(K, n)
+    q = np.array([outs[c].order for c in cols], dtype=int)
+    Z = _impedances(system, omega)
+    F = system.forcing.values(omega).reshape(K, n)
+    if not np.all(np.isfinite(F)):
+        bad = omega[~np.all(np.isfinite(F), axis=1)]
+        raise ValueError(f"F: the forcing returned a non-finite value at Ω = {bad[0]:g} rad/s")
+    X = np.linalg.solve(Z, F[..., None])[..., 0]
+    w = np.linalg.solve(np.swapaxes(Z, -1, -2), rows[..., None])[..., 0]  # adjoints: Zᵀ w = c
+    d = np.zeros(K, dtype=complex)
+    for c in np.unique(cols):  # one call per output with a feedthrough d(Ω)
+        if outs[c].feedthrough is not None:
+            d[cols == c] = outs[c].feedthrough_values(omega[cols == c])
     gain = (1j * omega) ** q
-    d = np.array([o.feedthrough.value(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])
-    dd = np.array([o.feedthrough.derivative(omega)[0] if o.feedthrough is not None else 0.0 for o in outs])
-    H = gain * (w @ F + d)
-    P = len(t.parameters)
-    rhs = np.zeros((system.n, P), dtype=complex)
-    for i in range(P):
-        Zi = t.dK[i] - omega**2 * t.dM[i] + 1j * omega * t.dC[i]
-        Fi = t.dF[i].value(omega) if t.dF[i] is not None else 0.0
-        rhs[:, i] = Fi - Zi @ X
-    dH = gain[:, None] * (w @ rhs)
-    dZ = -2 * omega * system.M + 1j * system.C
-    dgain = np.where(q > 0, q * 1j * (1j * omega) ** np.maximum(q - 1, 0), 0.0)
-    dHw = dgain * (w @ F + d) + gain * (w @ (system.forcing.derivative(omega) - dZ @ X) + dd)
+    wF = np.einsum("kj,kj->k", w, F)
+    H = gain * (wF + d)
+    outer = (w[:, :, None] * X[:, None, :]).reshape(K, n * n)
+    tangents = np.concatenate([t.dK, t.dM, t.dC]).reshape(3 * P, n * n)
+    wZX = outer @ tangents.T  # (K, 3P): w_kᵀ K_i X_k, w_kᵀ M_i X_k, w_kᵀ C_i X_k
+    rate = -(wZX[:, :P] - omega[:, None] ** 2 * wZX[:, P:2 * P] + 1j * omega[:, None] * wZX[:, 2 * P:])
+    dF = _tangent_forcing(t, n)
+    if dF is not None:
+        rate += np.einsum("kj,kij->ki", w, dF.values(omega).reshape(K, P, n))
+    dH = gain[:, None] * rate
+    dHw = np.zeros(K, dtype=complex)
+    for k in np.flatnonzero(slope):  # dF/dΩ and dd/dΩ are evaluated frequency by frequency (Forcing.derivative)
+        o, wk = outs[cols[k]], float(omega[k])
+        dd = o.feedthrough.derivative(wk)[0] if o.feedthrough is not None else 0.0
+        dZX = (-2 * wk * system.M + 1j * system.C) @ X[k]
+        dgain = q[k] * 1j * (1j * wk) ** (q[k] - 1) if q[k] > 0 else 0.0
+        dHw[k] = dgain * (wF[k] + d[k]) + gain[k] * (w[k] @ (system.forcing.derivative(wk) - dZX) + dd)
     return H, dH, dHw
 
 
-def _partials_at(system: LinearSystem, omega: float, cols: list[int], zone: ZeroZone | None,
-                 hi: float) -> tuple[np.ndarray, ...]:
-    """:func:`_partials`, or where Z(Ω) is singular to rounding (free rigid-body roots near 0, inside ``zone``) or
-    exactly singular, the limit model: the quadratic through the partials at three frequencies above Ω (the
-    zone's ε, 2ε, 4ε; or Ω + (1, 2, 4)·1e-7·hi), evaluated at Ω."""
-    if zone is not None and omega < zone.step:
-        nodes, weights = zone.nodes, zone.weights(omega)
-    else:
-        try:
-            return _partials(system, omega, cols)
-        except np.linalg.LinAlgError:  # a finite value at a singular Z: its limit from above
-            nodes = omega + 1e-7 * hi * np.array([1.0, 2.0, 4.0])
-            weights = ZeroZone(1e-7 * hi).weights(0.0)
-    parts = [_partials(system, float(w), cols) for w in nodes]
-    return tuple(sum(c * part[k] for c, part in zip(weights, parts, strict=True)) for k in range(3))
+def _partials_at(system: LinearSystem, omega: np.ndarray, cols: np.ndarray, slope: np.ndarray,
+                 zone: ZeroZone | None, hi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_partials` at every ``omega[k]``, or where Z(Ω) is singular to rounding (free rigid-body roots near 0,
+    inside ``zone``) or exactly singular, the limit model: the quadratic through the partials at three frequencies
+    above Ω (the zone's ε, 2ε, 4ε; or Ω + (1, 2, 4)·1e-7·hi), evaluated at Ω.  All frequencies and their nodes in
+    one stacked :func:`_partials` (a second one when some Z(Ω_k) is exactly singular)."""
+    models = {} if zone is None else {int(k): (zone, 0.0) for k in np.flatnonzero(omega < zone.step)}
+    try:
+        return _limit_models(system, omega, cols, slope, models)
+    except np.linalg.LinAlgError:  # a finite value at a singular Z: its limit from above
+        Z = _impedances(system, omega)
+        singular = np.linalg.slogdet(Z)[0] == 0  # the zero pivot that made the solve fail
+        limit = ZeroZone(1e-7 * hi)
+        models |= {int(k): (limit, float(omega[k])) for k in np.flatnonzero(singular) if k not in models}
+        return _limit_models(system, omega, cols, slope, models)
+
+
+def _limit_models(system: LinearSystem, omega: np.ndarray, cols: np.ndarray, slope: np.ndarray,
+                  models: dict[int, tuple[ZeroZone, float]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_partials` at ``omega``, except at the frequencies k of ``models`` = {k: (zone, origin)}: there the
+    quadratic through the partials at ``origin + zone.nodes`` (Lagrange weights ``zone.weights(Ω_k − origin)``)."""
+    K = len(omega)
+    direct = np.ones(K, dtype=bool)
+    direct[list(models)] = False
+    at, weight, owner = [omega[direct]], [np.ones(int(direct.sum()))], [np.flatnonzero(direct)]
+    for k, (z, origin) in models.items():
+        at.append(origin + z.nodes)
+        weight.append(z.weights(float(omega[k]) - origin))
+        owner.append(np.full(3, k))
+    at, owner = np.concatenate(at), np.concatenate(owner)
+    parts = _partials(system, at, cols[owner], slope[owner])
+    m = int(direct.sum())
+    result = []
+    for part in parts:
+        out = np.empty((K,) + part.shape[1:], dtype=part.dtype)
+        out[direct] = part[:m]
+        for j, k in enumerate(models):  # each limit model: its three nodes' weighted sum
+            out[k] = np.tensordot(weight[1 + j], part[m + 3 * j:m + 3 * j + 3], axes=1)
+        result.append(out)
+    return tuple(result)
 
 
 def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
@@ -215,36 +309,54 @@ def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tupl
                 raise ValueError(f"maxima: {name!r} was computed with exact={rm.exact} over {tuple(rm.band)} rad/s, "
                                  f"not exact={exact} over {(lo, hi)}")
     n, P = system.n, len(t.parameters)
-    dwd = damped_frequency_jacobian(system)
+    if not names:
+        return {}
     wd = system.damped_frequencies()
-    modes = system.mode_roots()
-    neutral = np.abs(modes) <= NEUTRAL_ROOT * float(np.max(np.abs(system.eigenvalues()), initial=0.0))
-    inside = (wd > lo) & (wd < hi) & ~neutral  # rigid-body roots (s ≈ 0) do not move a frequency of the maxima
     zone = zero_zone(system, hi)
-    dclip = np.where(inside[:, None], dwd, 0.0)
-    result = {}
+    dclip = None  # dω_dj/dp of the modes inside the band, computed when a maximum's frequency moves with one
+
+    def moving() -> np.ndarray:
+        nonlocal dclip
+        if dclip is None:
+            modes = system.mode_roots()
+            neutral = np.abs(modes) <= NEUTRAL_ROOT * float(np.max(np.abs(system.eigenvalues()), initial=0.0))
+            inside = (wd > lo) & (wd < hi) & ~neutral  # rigid-body roots (s ≈ 0) do not move a maximum's frequency
+            dclip = np.where(inside[:, None], damped_frequency_jacobian(system), 0.0)
+        return dclip
+
+    clipped = np.clip(wd, lo, hi)
+    bounds = np.concatenate([[lo], 0.5 * (clipped[1:] + clipped[:-1]), [hi]])
+    tol = 1e-9 * max(hi, 1.0)
+    omegas, cols, where, dOmegas = [], [], [], []
     for name in names:
         rm = maxima[name]
-        col = system.output_index(name)
         dOmega = np.zeros((n + 2, P))
-        if exact:
-            clipped = np.clip(wd, lo, hi)
-            bounds = np.concatenate([[lo], 0.5 * (clipped[1:] + clipped[:-1]), [hi]])
-            dbounds = np.zeros((n + 1, P))
-            dbounds[1:-1] = 0.5 * (dclip[1:] + dclip[:-1])
-            for j in range(n):
-                for b in (j, j + 1):
-                    if abs(rm.frequencies[j] - bounds[b]) <= 1e-9 * max(hi, 1.0):
-                        dOmega[j] = dbounds[b]
+        if exact:  # a maximum on a cell boundary moves with it (the upper one where it is on both)
+            f = np.asarray(rm.frequencies[:n], dtype=float)
+            on_hi, on_lo = np.abs(f - bounds[1:]) <= tol, np.abs(f - bounds[:-1]) <= tol
+            if np.any(on_hi[:-1] | on_lo[1:]):  # the band's own ends (lo, hi) do not move
+                dbounds = np.zeros((n + 1, P))
+                dbounds[1:-1] = 0.5 * (moving()[1:] + moving()[:-1])
+                dOmega[:n] = np.where(on_hi[:, None], dbounds[1:], np.where(on_lo[:, None], dbounds[:-1], 0.0))
         else:
-            dOmega[:n] = dclip
+            dOmega[:n] = moving()
+        keep = np.flatnonzero(np.isfinite(rm.values) & (rm.values != 0.0))
+        omegas.append(np.asarray(rm.frequencies, dtype=float)[keep])
+        cols.append(np.full(len(keep), system.output_index(name)))
+        where.append(keep)
+        dOmegas.append(dOmega[keep])
+    omega, dOmega = np.concatenate(omegas), np.concatenate(dOmegas)
+    slope = np.any(dOmega != 0.0, axis=1)
+    rows = np.zeros((0, P))
+    if len(omega):
+        H, dH, dHw = _partials_at(system, omega, np.concatenate(cols), slope, zone, hi)
+        rows = (np.real(np.conj(H)[:, None] * dH) + np.real(np.conj(H) * dHw)[:, None] * dOmega) / np.abs(H)[:, None]
+    result, start = {}, 0
+    for name, keep in zip(names, where, strict=True):
         J = np.zeros((n + 2, P))
-        for k, omega in enumerate(rm.frequencies):
-            if not np.isfinite(rm.values[k]) or rm.values[k] == 0.0:
-                continue
-            H, dH, dHw = _partials_at(system, float(omega), [col], zone, hi)
-            J[k] = (np.real(np.conj(H[0]) * dH[0]) + np.real(np.conj(H[0]) * dHw[0]) * dOmega[k]) / abs(H[0])
-        result[name] = (rm, J)
+        J[keep] = rows[start:start + len(keep)]
+        start += len(keep)
+        result[name] = (maxima[name], J)
     return result
 
 
