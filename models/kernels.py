@@ -268,10 +268,15 @@ def band_grid(poles: np.ndarray, lo: float, hi: float, max_delay: float, extra: 
 # ---------------------------------------------------------------------------------------------------- pole–residue
 @njit(**JIT)
 def _reciprocals(w: float, poles: np.ndarray, out: np.ndarray) -> None:
-    """out[k] = 1 / (iΩ − s_k) by Smith's division (no overflow of |d|²); inf at a pole."""
+    """out[k] = 1 / (iΩ − s_k) = conj(d)/|d|² (d = iΩ − s_k), by Smith's division where |d|² would over- or
+    underflow; inf at a pole."""
     for k in range(poles.size):
         dr, di = -poles[k].real, w - poles[k].imag
-        if dr == 0.0 and di == 0.0:
+        d2 = dr * dr + di * di
+        if 1e-290 < d2 < 1e290:
+            r = 1.0 / d2
+            out[k] = complex(dr * r, -di * r)
+        elif dr == 0.0 and di == 0.0:
             out[k] = complex(math.inf, 0.0)
         elif abs(dr) >= abs(di):
             r = di / dr
