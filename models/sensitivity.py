@@ -313,14 +313,13 @@ def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tupl
         return {}
     wd = system.damped_frequencies()
     zone = zero_zone(system, hi)
+    neutral = np.abs(system.mode_roots()) <= NEUTRAL_ROOT * float(np.max(np.abs(system.eigenvalues()), initial=0.0))
+    inside = (wd > lo) & (wd < hi) & ~neutral  # rigid-body roots (s ≈ 0) do not move a maximum's frequency
     dclip = None  # dω_dj/dp of the modes inside the band, computed when a maximum's frequency moves with one
 
     def moving() -> np.ndarray:
         nonlocal dclip
         if dclip is None:
-            modes = system.mode_roots()
-            neutral = np.abs(modes) <= NEUTRAL_ROOT * float(np.max(np.abs(system.eigenvalues()), initial=0.0))
-            inside = (wd > lo) & (wd < hi) & ~neutral  # rigid-body roots (s ≈ 0) do not move a maximum's frequency
             dclip = np.where(inside[:, None], damped_frequency_jacobian(system), 0.0)
         return dclip
 
@@ -334,7 +333,9 @@ def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tupl
         if exact:  # a maximum on a cell boundary moves with it (the upper one where it is on both)
             f = np.asarray(rm.frequencies[:n], dtype=float)
             on_hi, on_lo = np.abs(f - bounds[1:]) <= tol, np.abs(f - bounds[:-1]) <= tol
-            if np.any(on_hi[:-1] | on_lo[1:]):  # the band's own ends (lo, hi) do not move
+            # a cell boundary moves with its two modes: not at all where neither is inside the band (nor lo, hi)
+            movable = inside[1:] | inside[:-1]
+            if np.any((on_hi[:-1] | on_lo[1:]) & movable):
                 dbounds = np.zeros((n + 1, P))
                 dbounds[1:-1] = 0.5 * (moving()[1:] + moving()[:-1])
                 dOmega[:n] = np.where(on_hi[:, None], dbounds[1:], np.where(on_lo[:, None], dbounds[:-1], 0.0))
