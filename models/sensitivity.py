@@ -11,10 +11,11 @@ the system alone and shares its one eigen-decomposition:
 - exact method: f_j is a maximum over Ω, so by the envelope theorem ``df_j/dp = ∂|H|/∂p`` at the
   maximiser (plus the motion of a cell boundary when the maximum sits on one).
 
-``∂H/∂p_i = (iΩ)^q wᵀ(F_i − Z_i X)`` with the adjoint ``Zᵀw = c`` (one extra solve per frequency,
-all outputs at once).  Where free rigid-body roots make Z(Ω) singular to rounding (a band from 0 Hz: below
-:class:`~railopt.models.response_maxima.ZeroZone`'s step), H and ∂H/∂p are the same limit model the values use:
-the quadratic through the partials at ε, 2ε and 4ε, so the derivative is that of the value reported at Ω → 0.
+``∂H/∂p_i = (iΩ)^q wᵀ(F_i − Z_i X)`` with the adjoint ``Zᵀw = c`` (the direct and adjoint solves of every
+maximum's frequency, of all outputs, stacked in one call each).  Where free rigid-body roots make Z(Ω) singular to
+rounding (a band from 0 Hz: below :class:`~railopt.models.response_maxima.ZeroZone`'s step), H and ∂H/∂p are the
+same limit model the values use: the quadratic through the partials at ε, 2ε and 4ε, so the derivative is that of
+the value reported at Ω → 0.
 """
 
 from __future__ import annotations
