@@ -85,11 +85,17 @@ def discover_kinds() -> dict[str, StudyKind]:
 
 
 def dask_context(context: StudyContext):
-    """The dask client for a study run (``None`` = serial when ``workers == 0``)."""
+    """The dask client for a study run (``None`` = serial when ``workers == 0``).  Before any cluster starts the
+    driver compiles (or loads) the numerical kernels once, so that cold workers do not each compile them
+    (:mod:`railopt.studies.kernel_warmup`)."""
     from railopt.design.parallel import cluster_record, dask_client
 
     @contextmanager
     def recorded():
+        if context.workers != 0:
+            from railopt.studies.kernel_warmup import warm_kernels
+
+            warm_kernels(context.show_progress)
         with dask_client(context.workers, context.scheduler, timeout=context.scheduler_timeout) as client:
             where = "serial" if client is None else _where(client)
             if where not in context.executed_on:
