@@ -6,9 +6,15 @@ Since the compiled kernels (issue 25) the references are compared at the optimis
   1e-9 relative;
 * every other real number (design variables, speeds, damping ratios, changes, …): 1e-6 relative — designs are
   what the optimiser fixes to its tolerance, and the quantities derived from a design inherit it;
+* relative changes (columns named ``change…`` or ``…_change_…``, and ``objective_underestimate``): 1e-6
+  absolute — they are differences of nearly equal numbers, fractions of a reference, and round-off of a zero
+  change has no meaningful relative size;
 * counts of distinct optima, start counts, statuses, flags, labels and every other non-real column: exactly;
-* wall times, timestamps, the machine and a start's evaluation count (the optimiser's path, which rounding may
-  lengthen or shorten by a step) are left out.
+* the certificate's grid size (``grid_points``, a diagnostic): within 5 % — a bisection sitting at its threshold
+  or an exact duplicate adds or drops a point at round-off;
+* wall times, timestamps, the machine, a start's evaluation count (the optimiser's path, which rounding may
+  lengthen or shorten by a step) and which start represents an optimum (``start_id``/``best_start`` of optima
+  and recommendations: a tie between starts that reached the same design, broken at round-off) are left out.
 
 docs/reliability.md states the same rule for readers.
 """
@@ -24,11 +30,18 @@ U_COLUMNS = {"U", "value", "existing_U", "U_objective", "true_peak", "peak", "ni
              "after", "amplitude", "t"}
 U_RTOL = 1e-9
 DESIGN_RTOL = 1e-6
+CHANGE_ATOL = 1e-6
+GRID_RTOL = 0.05
 VOLATILE = {"timing.csv"}
 
 
-def _volatile(column: str) -> bool:
-    return column.startswith("wall_time") or column in {"finished_utc", "evaluations"}
+def _volatile(column: str, table: str) -> bool:
+    representative = table != "starts" and column in {"start_id", "best_start"}
+    return column.startswith("wall_time") or column in {"finished_utc", "evaluations"} or representative
+
+
+def _is_change(column: str) -> bool:
+    return column.startswith("change") or "_change_" in column or column == "objective_underestimate"
 
 
 def tables(folder: Path) -> dict[str, pd.DataFrame]:
@@ -37,7 +50,7 @@ def tables(folder: Path) -> dict[str, pd.DataFrame]:
     for path in sorted(folder.glob("*.csv")):
         if path.name not in VOLATILE:
             df = pd.read_csv(path)
-            out[path.stem] = df.drop(columns=[c for c in df.columns if _volatile(c)])
+            out[path.stem] = df.drop(columns=[c for c in df.columns if _volatile(c, path.stem)])
     return out
 
 
@@ -49,12 +62,14 @@ def differences(fresh: pd.DataFrame, committed: pd.DataFrame) -> list[str]:
     out = []
     for column in committed.columns:
         a, b = fresh[column], committed[column]
-        if pd.api.types.is_float_dtype(b) or pd.api.types.is_float_dtype(a):
+        if column == "grid_points" or pd.api.types.is_float_dtype(b) or pd.api.types.is_float_dtype(a):
             x, y = a.to_numpy(float), b.to_numpy(float)
-            rtol = U_RTOL if column in U_COLUMNS else DESIGN_RTOL
-            bad = ~np.isclose(x, y, rtol=rtol, atol=0.0, equal_nan=True)
-            out += [f"{column}[{i}]: {x[i]!r} vs {y[i]!r} (rel {abs(x[i] - y[i]) / max(abs(y[i]), 1e-300):.1e} > "
-                    f"{rtol:g})" for i in np.flatnonzero(bad)]
+            rtol, atol = ((0.0, CHANGE_ATOL) if _is_change(column) else (GRID_RTOL, 0.0) if column == "grid_points"
+                          else (U_RTOL if column in U_COLUMNS else DESIGN_RTOL, 0.0))
+            bad = ~np.isclose(x, y, rtol=rtol, atol=atol, equal_nan=True)
+            out += [f"{column}[{i}]: {x[i]!r} vs {y[i]!r} (|Δ| {abs(x[i] - y[i]):.1e}, rel "
+                    f"{abs(x[i] - y[i]) / max(abs(y[i]), 1e-300):.1e}; rtol {rtol:g}, atol {atol:g})"
+                    for i in np.flatnonzero(bad)]
         elif not a.equals(b):
             out += [f"{column}[{i}]: {a.iloc[i]!r} vs {b.iloc[i]!r} (exact)" for i in np.flatnonzero(
                 (a.astype(str) != b.astype(str)).to_numpy())]

@@ -26,3 +26,18 @@ def test_a_missing_row_or_column_is_a_difference():
     base = _table()
     assert "shape or columns" in differences(pd.concat([base, base]), base)[0]
     assert "shape or columns" in differences(base.drop(columns="status"), base)[0]
+
+
+def test_changes_are_absolute_the_grid_size_within_5_percent_and_representative_starts_left_out(tmp_path):
+    from reference_rule import tables
+
+    base = _table(change_vs_existing=-1.4e-15, grid_points=90)
+    assert differences(_table(change_vs_existing=4e-16, grid_points=91), base) == []  # round-off of a zero change
+    assert [d.split("[")[0] for d in differences(_table(change_vs_existing=2e-6, grid_points=90), base)] == [
+        "change_vs_existing"]
+    assert [d.split("[")[0] for d in differences(_table(change_vs_existing=-1.4e-15, grid_points=96), base)] == [
+        "grid_points"]
+    for name in ("optima", "starts"):
+        _table(start_id=3).to_csv(tmp_path / f"{name}.csv", index=False)
+    read = tables(tmp_path)
+    assert "start_id" not in read["optima"] and "start_id" in read["starts"]
