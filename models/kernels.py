@@ -342,15 +342,24 @@ def pole_residue_magnitudes(w: np.ndarray, poles: np.ndarray, R: np.ndarray, o: 
 
 
 def magnitudes(w: np.ndarray, data) -> np.ndarray:
-    """f(Ω) of the peak search at the points ``w`` (1-D float64): ``data(w)`` for a Python callable, or the
-    pole–residue magnitude for ``data = (poles, R, o, delays, q)`` (what compiled drivers receive)."""
+    """f(Ω) of the peak search at the points ``w`` (1-D float64): ``data(w)`` for a Python callable, the
+    pole–residue magnitude for ``data = (poles, R, o, delays, q)``, or the direct-solve magnitude of
+    :func:`direct_magnitudes` for ``data = (M, C, K, A, delays, row, order)`` (what compiled drivers receive)."""
     if callable(data):
         return np.asarray(data(w), dtype=float)
+    if len(data) == 7:
+        return direct_magnitudes(w, *data)
     return pole_residue_magnitudes(w, *data)
 
 
 @overload(magnitudes, jit_options={"error_model": "numpy", "nogil": True})
 def _magnitudes_compiled(w, data):
+    if len(data) == 7:
+        def direct(w, data):
+            return direct_magnitudes(w, data[0], data[1], data[2], data[3], data[4], data[5], data[6])
+
+        return direct
+
     def impl(w, data):
         return pole_residue_magnitudes(w, data[0], data[1], data[2], data[3], data[4])
 
@@ -702,11 +711,304 @@ def cell_maxima_pole_residue(grid: np.ndarray, values: np.ndarray, bounds: np.nd
     return refine_cells(grid, values, bounds, rtol, (poles, R, o, delays, q))
 
 
+
+# ---------------------------------------------------------------------------------------------------- direct outputs
+@njit(**JIT)
+def forcing_values(w: float, A: np.ndarray, delays: np.ndarray, out: np.ndarray) -> bool:
+    """out (n,) = F(Ω) = Σ_t e^{−iΩτ_t} Σ_j (iΩ)^j A[t, j] (thesis eqs. 4.63–4.66); False when not finite."""
+    iw = complex(0.0, w)
+    out[:] = 0j
+    for t in range(A.shape[0]):
+        phase = complex(math.cos(w * delays[t]), -math.sin(w * delays[t])) if delays[t] != 0.0 else 1.0 + 0j
+        power = phase
+        for j in range(A.shape[1]):
+            for i in range(A.shape[2]):
+                out[i] += power * A[t, j, i]
+            power *= iw
+    for i in range(out.size):
+        if not (math.isfinite(out[i].real) and math.isfinite(out[i].imag)):
+            return False
+    return True
+
+
+@njit(**JIT)
+def direct_outputs(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: np.ndarray, A: np.ndarray, delays: np.ndarray,
+                   rows: np.ndarray, orders: np.ndarray) -> tuple[np.ndarray, int]:
+    """H (N, m) = (iΩ)^q_o c_o·Z(Ω)⁻¹F(Ω) (thesis eqs. 4.69–4.70) at each Ω of ``w`` (N,) for the polynomial
+    delayed forcing A (T, J, n), delays (T,), output rows (m, n) and orders (m,) int64; +inf where not finite.
+    Status 0, or 1 when F or Z(Ω) is not finite somewhere (nothing solved: the caller names it); numpy's
+    ``LinAlgError`` when a Z(Ω) is exactly singular.  THE direct-solve formula of the certified path."""
+    n, m = M.shape[0], rows.shape[0]
+    H = np.full((w.size, m), complex(math.inf, 0.0))
+    F = np.empty(n, np.complex128)
+    Z = np.empty((n, n), np.complex128)
+    for t in range(w.size):
+        if not forcing_values(w[t], A, delays, F):
+            return H, 1
+        x = w[t]
+        for i in range(n):
+            for j in range(n):
+                Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
+                if not (math.isfinite(Z[i, j].real) and math.isfinite(Z[i, j].imag)):
+                    return H, 1
+    for t in range(w.size):
+        x = w[t]
+        forcing_values(x, A, delays, F)
+        for i in range(n):
+            for j in range(n):
+                Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
+        X = np.linalg.solve(Z, F)
+        for o in range(m):
+            h = 0j
+            for i in range(n):
+                h += rows[o, i] * X[i]
+            for _ in range(orders[o]):
+                h *= complex(0.0, x)
+            if math.isfinite(h.real) and math.isfinite(h.imag):
+                H[t, o] = h
+    return H, 0
+
+
+@njit(**JIT)
+def direct_magnitudes(w: np.ndarray, M: np.ndarray, C: np.ndarray, K: np.ndarray, A: np.ndarray,
+                      delays: np.ndarray, rows: np.ndarray, orders: np.ndarray) -> np.ndarray:
+    """|H| (N,) of the one output ``rows`` (1, n) by :func:`direct_outputs` (+inf where Z or F is not finite)."""
+    H, status = direct_outputs(M, C, K, w, A, delays, rows, orders)
+    out = np.empty(w.size)
+    for i in range(w.size):
+        a = abs(H[i, 0])
+        out[i] = a if status == 0 and math.isfinite(a) else math.inf
+    return out
+
+
+# ---------------------------------------------------------------------------------------------------- certified path
+CERT_OK, CERT_UNSTABLE, CERT_ZERO_ZONE, CERT_ILL_CONDITIONED, CERT_INCONSISTENT, CERT_NOT_FINITE = range(6)
+CERTIFIED_MAXIMA_STATUS = ("ok", "unstable", "zero zone", "ill-conditioned eigenvectors",
+                           "pole–residue inconsistent with direct solves", "forcing or impedance not finite")
+
+
+@njit(**JIT)
+def mode_order(s: np.ndarray) -> np.ndarray:
+    """Order of the roots by |Im s|, then Re s (ascending; stable): :func:`railopt.models.modal.mode_order`."""
+    N = s.size
+    idx = np.arange(N)
+    for i in range(1, N):  # insertion sort: 2n is small and the order must be stable as numpy's lexsort
+        k = idx[i]
+        j = i - 1
+        while j >= 0 and (abs(s[idx[j]].imag) > abs(s[k].imag)
+                          or (abs(s[idx[j]].imag) == abs(s[k].imag) and s[idx[j]].real > s[k].real)):
+            idx[j + 1] = idx[j]
+            j -= 1
+        idx[j + 1] = k
+    return idx
+
+
+@njit(**JIT)
+def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray, V: np.ndarray, A: np.ndarray,
+                     delays: np.ndarray, rows: np.ndarray, orders: np.ndarray, lo: float, hi: float,
+                     max_delay: float, count: int, settings: np.ndarray):
+    """The certified band maximum of every output in one call (:mod:`railopt.models.response_maxima`).
+
+    M, C, K (n, n) float64; s (2n,), V (2n, 2n) complex128 from ``np.linalg.eig(G)``; A (T, J, n) complex128
+    forcing coefficients with delays (T,) s; rows (m, n) output rows, orders (m,) int64; band [lo, hi] rad/s;
+    ``count`` points of the uniform floor/delay grid; settings = (UNDAMPED_ROOT, NEUTRAL_ROOT, ZERO_STEP,
+    CONDITION_LIMIT, CONSISTENCY_RTOL, POLISH_RTOL, BRACKET_RTOL, GRID_FACTOR, POLE_STEP, MAX_GRID_POINTS,
+    RESOLVED_DAMPING).
+
+    The chain: mode order and the checks on the roots (growth → status 1; free rigid-body roots with the band
+    below their zone's step → 2), W = V⁻¹ and cond₁(V) (beyond the limit → 3), residues, band grid, pole–residue
+    |H| on it, the cell maxima refined on it, the n + 2 confirmation solves (values), the consistency of the two
+    (beyond CONSISTENCY_RTOL → 4), and a noisy maximiser located again on direct solves; F or Z not finite → 5.
+    A status ≠ 0 means the caller takes the general path.
+
+    Returns (status, values (m, n+2), freqs (m, n+2), ratio, grid points, all samples finite, resonant (n,) bool,
+    soft root index into s (−1: none), unresolved pole index into s (−1: none), its eigenvalue condition, W, cond).
+    An undamped mode inside the band (resonant) has value inf at its clipped ω_d.
+    """
+    undamped_root, neutral_root, zero_step, condition_limit = settings[0], settings[1], settings[2], settings[3]
+    consistency_rtol, polish_rtol, rtol, grid_factor = settings[4], settings[5], settings[6], settings[7]
+    pole_step, max_points, resolved = settings[8], int(settings[9]), settings[10]
+    n, m, N = M.shape[0], rows.shape[0], s.size
+    values = np.full((m, n + 2), math.inf)
+    freqs = np.zeros((m, n + 2))
+    resonant = np.zeros(n, np.bool_)
+    W = np.zeros((0, 0), np.complex128)
+    order = mode_order(s)
+    scale = 0.0
+    for k in range(N):
+        scale = max(scale, abs(s[k]))
+    wd = np.empty(n)
+    clipped = np.empty(n)
+    for j in range(n):
+        mode = s[order[2 * j + 1]]
+        wd[j] = abs(mode.imag)
+        clipped[j] = min(max(wd[j], lo), hi)
+        freqs[:, j] = clipped[j]
+        neutral = abs(mode) <= neutral_root * scale
+        resonant[j] = (abs(mode.real) <= undamped_root * abs(mode) and mode.imag != 0 and not neutral
+                       and wd[j] >= lo and wd[j] <= hi)
+    freqs[:, n], freqs[:, n + 1] = lo, hi
+    nneutral, least = 0, math.inf
+    for k in range(N):
+        if s[k].real > undamped_root * abs(s[k]) and abs(s[k]) > neutral_root * scale:
+            return (CERT_UNSTABLE, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, math.inf)
+        if abs(s[k]) <= neutral_root * scale:
+            nneutral += 1
+        else:
+            least = min(least, abs(s[k]))
+    if scale > 0 and 0 < nneutral < N and lo < min(zero_step * least, 1e-3 * hi):
+        return (CERT_ZERO_ZONE, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, math.inf)
+    W, cond = left_vectors(V)
+    if cond > condition_limit:
+        return (CERT_ILL_CONDITIONED, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, cond)
+    # the grid's poles: not undamped (their cells are inf anyway)
+    keep = np.zeros(N, np.bool_)
+    for k in range(N):
+        keep[k] = abs(s[k].real) > undamped_root * abs(s[k])
+    poles = np.ascontiguousarray(s[keep])
+    bounds = np.empty(n + 1)
+    bounds[0], bounds[n] = lo, hi
+    for j in range(1, n):
+        bounds[j] = max(0.5 * (clipped[j] + clipped[j - 1]), lo)
+    extra = np.concatenate((clipped, bounds))
+    grid, ratio = band_grid(poles, lo, hi, max_delay, extra, count, grid_factor, pole_step, max_points)
+    R, _ = residues(M, V, W, rows, A)
+    cx = np.empty((m, n))
+    cf = np.empty((m, n))
+    all_finite = True
+    for o in range(m):
+        mags = pole_residue_magnitudes(grid, s, R, o, delays, orders[o])
+        for i in range(mags.size):
+            if not math.isfinite(mags[i]):
+                all_finite = False
+        x, f, _ = refine_cells(grid, mags, bounds, rtol, (s, R, o, delays, orders[o]))
+        cx[o], cf[o] = x, f
+    # confirmation: the n refined maxima of each output and the two edges, by direct solves
+    pts = np.empty(m * n + 2)
+    for o in range(m):
+        pts[o * n:(o + 1) * n] = cx[o]
+    pts[m * n], pts[m * n + 1] = lo, hi
+    H, status = direct_outputs(M, C, K, pts, A, delays, rows, orders)
+    if status:
+        return (CERT_NOT_FINITE, values, freqs, ratio, grid.size, all_finite, resonant, -1, -1, math.nan, W, cond)
+    top = 0.0
+    for o in range(m):
+        for j in range(n):
+            values[o, j] = abs(H[o * n + j, o])
+            if not math.isfinite(values[o, j]):
+                values[o, j] = math.inf
+            elif math.isfinite(cf[o, j]):
+                top = max(top, values[o, j])
+        for e in range(2):
+            a = abs(H[m * n + e, o])
+            values[o, n + e] = a if math.isfinite(a) else math.inf
+    for o in range(m):
+        for j in range(n):
+            f, d = cf[o, j], values[o, j]
+            if math.isfinite(f) and math.isfinite(d) and abs(f - d) > consistency_rtol * max(top, 1e-300):
+                return (CERT_INCONSISTENT, values, freqs, ratio, grid.size, all_finite, resonant, -1, -1, math.nan,
+                        W, cond)
+    for o in range(m):  # a maximiser found on the noisy sum (noise ≳ POLISH_RTOL) is located again on direct solves
+        row = np.ascontiguousarray(rows[o:o + 1])
+        order_o = orders[o:o + 1].copy()
+        for j in range(n):
+            f, d, x = cf[o, j], values[o, j], cx[o, j]
+            if math.isfinite(f) and math.isfinite(d) and abs(f - d) > polish_rtol * abs(d):
+                a = max(grid[max(np.searchsorted(grid, x, side="left") - 1, 0)], bounds[j])
+                b = min(grid[min(np.searchsorted(grid, x, side="right"), grid.size - 1)], bounds[j + 1])
+                if a < x < b:
+                    trio = np.array([a, x, b])
+                    data = (M, C, K, A, delays, row, order_o)
+                    xr, fr, _ = refine_cells(trio, direct_magnitudes(trio, *data), np.array([a, b]), rtol, data)
+                    if fr[0] > d:
+                        cx[o, j], values[o, j] = xr[0], fr[0]
+    for o in range(m):
+        for j in range(n):
+            if resonant[j]:
+                values[o, j], freqs[o, j] = math.inf, clipped[j]
+            else:
+                freqs[o, j] = cx[o, j]
+    # the roots too soft for the search, and a pole whose damping is within the rounding of its eigenvalue
+    soft, unresolved, kappa_u = -1, -1, math.nan
+    rounding = EPS * scale
+    for k in range(N):
+        if (soft < 0 and abs(s[k]) <= neutral_root * scale and s[k].imag != 0
+                and -s[k].real > resolved * rounding):
+            soft = k
+        inside = (abs(s[k].imag) >= lo and abs(s[k].imag) <= hi and abs(s[k]) > neutral_root * scale
+                  and abs(s[k].real) > undamped_root * abs(s[k]))
+        if inside and unresolved < 0:
+            nv, nw = 0.0, 0.0
+            for i in range(N):
+                nv += abs(V[i, k]) ** 2
+                nw += abs(W[k, i]) ** 2
+            kappa = math.sqrt(nv) * math.sqrt(nw)
+            if not abs(s[k].real) > resolved * EPS * kappa * scale:
+                unresolved, kappa_u = k, kappa
+    return (CERT_OK, values, freqs, ratio, grid.size, all_finite, resonant, soft, unresolved, kappa_u, W, cond)
+
+
+@njit(**JIT)
+def state_matrices(M: np.ndarray, C: np.ndarray, K: np.ndarray,
+                   singular_pivot: float) -> tuple[np.ndarray, np.ndarray]:
+    """G (B, 2n, 2n) = [[0, I], [−M⁻¹K, −M⁻¹C]] (thesis eq. 4.53) of B stacked members (M, C, K (B, n, n)) by
+    :func:`member_state`, and which have a regular M (B,) bool (G is zero otherwise)."""
+    B, n = M.shape[0], M.shape[1]
+    G = np.zeros((B, 2 * n, 2 * n))
+    regular = np.zeros(B, np.bool_)
+    for b in range(B):
+        kc, ok = member_state(M[b], K[b], C[b], singular_pivot)
+        regular[b] = ok
+        if ok:
+            for i in range(n):
+                G[b, i, n + i] = 1.0
+                for j in range(2 * n):
+                    G[b, n + i, j] = -kc[i, j]
+    return G, regular
+
+
+@njit(**JIT)
+def certified_maxima_batch(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray, V: np.ndarray,
+                           A: np.ndarray, delays: np.ndarray, rows: np.ndarray, orders: np.ndarray, lo: float,
+                           hi: float, max_delay: float, count: int, settings: np.ndarray, regular: np.ndarray):
+    """:func:`certified_maxima` of B stacked designs in one call: M, C, K (B, n, n), s (B, 2n), V (B, 2n, 2n),
+    A (B, T, J, n); the rest shared.  ``regular`` (B,) False skips a design (status −1).  A design whose V or a
+    Z(Ω) is exactly singular gets status −2 (the caller redoes it on the general path).
+
+    Returns (status (B,) int64, values (B, m, n+2), freqs (B, m, n+2), ratio (B,), grid points (B,), all samples
+    finite (B,), soft (B,), unresolved (B,)): the same items as :func:`certified_maxima`, per design.
+    """
+    B, n, m = M.shape[0], M.shape[1], rows.shape[0]
+    status = np.full(B, -1, np.int64)
+    values = np.full((B, m, n + 2), math.inf)
+    freqs = np.zeros((B, m, n + 2))
+    ratio = np.full(B, math.nan)
+    points = np.zeros(B, np.int64)
+    finite = np.zeros(B, np.bool_)
+    soft = np.full(B, -1, np.int64)
+    unresolved = np.full(B, -1, np.int64)
+    for b in range(B):
+        if not regular[b]:
+            continue
+        try:
+            out = certified_maxima(M[b], C[b], K[b], s[b], V[b], A[b], delays, rows, orders, lo, hi, max_delay,
+                                   count, settings)
+        except Exception:  # noqa: BLE001 — numba raises LinAlgError for an exactly singular V or Z(Ω)
+            status[b] = -2
+            continue
+        status[b] = out[0]
+        values[b], freqs[b], ratio[b], points[b], finite[b] = out[1], out[2], out[3], out[4], out[5]
+        soft[b], unresolved[b] = out[7], out[8]
+    return status, values, freqs, ratio, points, finite, soft, unresolved
+
+
 __all__ = [
     "BRACKET_RTOL", "CANDIDATE_MARGIN", "INV_PHI", "MAX_ITERATIONS", "VERTEX_ITERATIONS", "all_positive", "c_array",
     "band_grid", "brent_accept", "brent_points", "brent_propose", "brent_run", "brent_set_start", "brent_start",
-    "cell_candidates", "cell_maxima_pole_residue", "cell_select", "direct_solutions", "drop_falling_edges", "dual",
+    "cell_candidates", "cell_maxima_pole_residue", "cell_select", "certified_maxima", "certified_maxima_batch",
+    "direct_magnitudes",
+    "direct_outputs", "direct_solutions", "forcing_values", "mode_order", "drop_falling_edges", "dual",
     "edge_probes", "left_vectors", "log_or_value", "magnitudes", "member_state", "pole_residue_magnitudes",
-    "pole_residue_sums", "refine_cells", "residues", "take_better",
+    "pole_residue_sums", "refine_cells", "residues", "state_matrices", "take_better",
     "vertex_points", "vertex_run", "vertex_start", "vertex_update",
 ]

@@ -46,6 +46,13 @@ class Modal(ArrayRecord):
         W.setflags(write=False)
         return W, condition
 
+    def remember_left(self, W: np.ndarray, condition: float) -> None:
+        """Keep W = V⁻¹ and cond₁(V) worked out elsewhere (the compiled certified path) for later reads."""
+        if "_left" not in self.__dict__:
+            W = np.array(W)
+            W.setflags(write=False)
+            self.__dict__["_left"] = (W, float(condition))
+
     @property
     def W(self) -> np.ndarray:
         """Left eigenvectors (2n, 2n), rows, W = V⁻¹ (NaN when V is exactly singular)."""

@@ -35,13 +35,8 @@ class PoleResidue:
         self.poles = np.array(decomposition.s, dtype=complex)  # a writeable C copy: the kernels' one signature
         self.orders = np.asarray(orders)
         V = c_array(decomposition.V, complex)
-        poly = [t for t in forcing.terms if t.coefficients is not None]
         self._callables = [t for t in forcing.terms if t.coefficients is None]
-        self._delays = np.array([t.delay for t in poly], dtype=float)
-        degree = max((t.coefficients.shape[0] for t in poly), default=1)
-        A = np.zeros((len(poly), degree, M.shape[0]), dtype=complex)  # every term's coefficients stacked
-        for ti, t in enumerate(poly):
-            A[ti, : t.coefficients.shape[0]] = t.coefficients
+        A, self._delays = forcing_arrays(forcing, M.shape[0])
         # R[k, o, t, j] = (c_o·V_x[:, k]) (W_v M⁻¹ A_tj)_k; B = W_v M⁻¹ (2n, n) serves the callable terms
         self._R, self._B = residues(c_array(M), V, c_array(decomposition.W, complex), c_array(rows), A)
         self._Cv = rows @ V[: M.shape[0]]  # (m, 2n)
@@ -93,8 +88,21 @@ class PoleResidue:
         return H
 
 
+def forcing_arrays(forcing: Forcing, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The polynomial terms of ``forcing`` stacked for the kernels: A (T, J, n) complex128 with
+    ``F(Ω) = Σ_t e^{−iΩ delays[t]} Σ_j (iΩ)^j A[t, j]`` (thesis eqs. 4.63–4.66; callable terms left out), delays (T,)
+    in s."""
+    poly = [t for t in forcing.terms if t.coefficients is not None]
+    delays = np.array([t.delay for t in poly], dtype=float)
+    degree = max((t.coefficients.shape[0] for t in poly), default=1)
+    A = np.zeros((len(poly), degree, n), dtype=complex)  # every term's coefficients stacked
+    for ti, t in enumerate(poly):
+        A[ti, : t.coefficients.shape[0]] = t.coefficients
+    return A, delays
+
+
 def _floats(a: object) -> np.ndarray:
     return c_array(np.ravel(a))
 
 
-__all__ = ["PoleResidue"]
+__all__ = ["PoleResidue", "forcing_arrays"]

@@ -37,14 +37,16 @@ import numpy as np
 import pandas as pd
 
 from railopt.models import kernels
-from railopt.models.modal import NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots
+from railopt.models.modal import CONDITION_LIMIT, NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots
 from railopt.models.peak_search import BRACKET_RTOL, cell_maxima
+from railopt.models.pole_residue import forcing_arrays
 from railopt.models.units import rad_s_to_hz
 from railopt.models.validation import band as validate_band
 from railopt.models.validation import band_arg
 from railopt.records import ArrayRecord
 
 if TYPE_CHECKING:  # pragma: no cover
+    from railopt.models.parametric import MemberStack
     from railopt.models.system import LinearSystem
 
 GRID_FACTOR = 0.25  # max grid step / distance to nearest pole
@@ -55,7 +57,8 @@ MAX_GRID_POINTS = 200_000
 CONSISTENCY_RTOL = 1e-6  # pole–residue vs direct value at a refined maximum; beyond it, redo by direct solves
 POLISH_RTOL = 1e-12  # beyond it (but within CONSISTENCY_RTOL), that maximiser is located again on direct solves
 
-__all__ = ["CERTIFIED_RTOL", "ResponseMaxima", "ZeroZone", "all_response_maxima", "band_grid", "peak",
+__all__ = ["CERTIFIED_RTOL", "ResponseMaxima", "ZeroZone", "all_response_maxima", "band_grid",
+           "batch_response_maxima", "peak",
            "response_maxima", "validate_band", "zero_zone"]
 
 
@@ -188,6 +191,9 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
     names = list(system.output_names if outputs is None else outputs)
     cols = [system.output_index(nm) for nm in names]
     if exact:
+        compiled = _certified(system, (lo, hi), names, cols)
+        if compiled is not None:  # the common case: the whole exact path in one compiled call
+            return compiled
         system.modal()  # one eigen-decomposition with vectors serves the roots too
     roots = system.eigenvalues()  # one sort serves ω_d, the undamped modes, the growth check and the zero limit
     modes = roots[1::2]  # = system.mode_roots()
@@ -347,10 +353,125 @@ def _near_zero(system: LinearSystem, zone: ZeroZone, cols: list[int], lo: float)
     return _NearZero(values, error, growing)
 
 
+def batch_response_maxima(stack: MemberStack, band: object = None, *, band_hz: tuple[float, float] | None = None,
+                          band_rad_s: tuple[float, float] | None = None, output: str | None = None) -> np.ndarray:
+    """The certified f_k (exact method) of one output for every member of ``stack`` at once: (B, n + 2) values,
+    row b equal to ``all_response_maxima(stack.member(b), ..., exact=True)[output].values``.
+
+    The M⁻¹[K C] of all members and their state matrices in one compiled call, the eigen-decompositions stacked in
+    one ``np.linalg.eig``, then :func:`railopt.models.kernels.certified_maxima_batch` (one call).  A member whose
+    kernel status sends it to the general path (growth, the rigid-body zone, cond(V) beyond CONDITION_LIMIT, an
+    inconsistent pole–residue sum, a singular V or Z(Ω)), or an output with a feedthrough, is recomputed on
+    :func:`all_response_maxima`; a member the model refuses (a singular M, a ``ValueError`` there) is a row of +inf.
+
+    Raises ``ValueError`` naming ``output`` for an unknown output or ``band`` for a bad band.
+    """
+    lo, hi = band_arg(band, band_hz, band_rad_s)
+    names = list(stack.outputs)
+    if output is None:
+        output = names[0] if names else None
+    if output not in stack.outputs:
+        raise ValueError(f"output: unknown output {output!r}; outputs are {names}")
+    chosen = stack.outputs[output]
+    B, n = stack.M.shape[0], stack.M.shape[1]
+    out = np.full((B, n + 2), np.inf)
+    general = np.ones(B, dtype=bool)
+    if chosen.feedthrough is None and B:
+        M, C, K = (kernels.c_array(a) for a in (stack.M, stack.C, stack.K))
+        G, regular = kernels.state_matrices(M, C, K, 1e-14)
+        s, V = np.linalg.eig(G)
+        delays = kernels.c_array(stack.delays)
+        max_delay = float(np.max(delays, initial=0.0))
+        count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points((lo, hi), max_delay), MAX_GRID_POINTS))
+        status, values, *_ = kernels.certified_maxima_batch(
+            M, C, K, kernels.c_array(s, complex), kernels.c_array(V, complex),
+            kernels.c_array(stack.coefficients, complex), delays, kernels.c_array(np.atleast_2d(chosen.row)),
+            np.array([chosen.order], dtype=np.int64), float(lo), float(hi), max_delay, int(count), _SETTINGS, regular)
+        ok = status == kernels.CERT_OK
+        out[ok] = values[ok, 0]
+        general = ~ok & regular  # a singular M is refused (+inf), as LinearSystem refuses it
+    for b in np.flatnonzero(general):
+        try:
+            out[b] = all_response_maxima(stack.member(int(b)), band_rad_s=(lo, hi), exact=True,
+                                         outputs=[output])[output].values
+        except ValueError:
+            out[b] = np.inf
+    return out
+
+
+_SETTINGS = np.array([UNDAMPED_ROOT, NEUTRAL_ROOT, ZERO_STEP, CONDITION_LIMIT, CONSISTENCY_RTOL, POLISH_RTOL,
+                      BRACKET_RTOL, GRID_FACTOR, POLE_STEP, MAX_GRID_POINTS, RESOLVED_DAMPING])
+
+
+def _certified(system: LinearSystem, band: tuple[float, float], names: list[str],
+               cols: list[int]) -> dict[str, ResponseMaxima] | None:
+    """The exact path by :func:`railopt.models.kernels.certified_maxima` (one compiled call after the
+    eigen-decomposition), or None where the general path must run: a callable forcing or undeclared delay, an output
+    with a feedthrough, and whatever the kernel's status sends back (growth, the rigid-body zone, cond(V) beyond
+    CONDITION_LIMIT, pole–residue inconsistent with direct solves, F or Z not finite, a singular Z)."""
+    outs = list(system.outputs.values())
+    chosen = [outs[c] for c in cols]
+    max_delay = system.max_delay
+    if not system.forcing.is_polynomial or max_delay is None or any(o.feedthrough is not None for o in chosen):
+        return None
+    lo, hi = band
+    modal = system.modal()
+    A, delays = forcing_arrays(system.forcing, system.n)
+    rows = kernels.c_array(np.array([o.row for o in chosen], dtype=float))
+    orders = np.array([o.order for o in chosen], dtype=np.int64)
+    count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points((lo, hi), max_delay), MAX_GRID_POINTS))
+    try:
+        (status, values, freqs, ratio, points, all_finite, resonant, soft, unresolved, kappa, W,
+         condition) = kernels.certified_maxima(
+            kernels.c_array(system.M), kernels.c_array(system.C), kernels.c_array(system.K),
+            kernels.c_array(modal.s, complex), kernels.c_array(modal.V, complex), A, delays, rows, orders,
+            float(lo), float(hi), float(max_delay), int(count), _SETTINGS)
+    except np.linalg.LinAlgError:  # V or a Z(Ω) exactly singular
+        return None
+    if W.size:
+        modal.remember_left(W, condition)
+    if status != kernels.CERT_OK:
+        return None
+    roots = system.eigenvalues()
+    wd = np.abs(roots[1::2].imag)
+    why = _reasons(band, max_delay, ratio, all_finite, resonant, roots, wd,
+                   None if soft < 0 else modal.s[soft], None if unresolved < 0 else modal.s[unresolved], kappa)
+    return {nm: ResponseMaxima(values[i], freqs[i], wd, (lo, hi), exact=True, certified=not why, grid_ratio=ratio,
+                               output=nm, evaluation="pole-residue", grid_points=int(points), reason="; ".join(why))
+            for i, nm in enumerate(names)}
+
+
 def _uncertified(system: LinearSystem, modal, roots: np.ndarray, resonant: np.ndarray, wd: np.ndarray,
                  band: tuple[float, float], max_delay: float | None, ratio: float, all_finite: bool) -> list[str]:
     """Why the cell maxima are not certified (empty when they are), common to every output."""
     lo, hi = band
+    # neutral roots are taken as free rigid-body motion (s = 0 up to rounding: real pairs ±δ, or ±iδ on the axis); a
+    # complex pair among them damped beyond rounding is a genuine mode too soft for the search, whose peak is missed
+    s = modal.s
+    scale = float(np.max(np.abs(s), initial=0.0))
+    rounding = np.finfo(float).eps * scale
+    soft = (np.abs(s) <= NEUTRAL_ROOT * scale) & (s.imag != 0) & (-s.real > RESOLVED_DAMPING * rounding)
+    soft_root = s[soft][0] if soft.any() else None
+    # a pole whose damping is within rounding of the eigenvalue: the grid, built around the computed pole, cannot
+    # be trusted to resolve the true peak (near-defective pairs, tiny damping)
+    inside = ((np.abs(s.imag) >= lo) & (np.abs(s.imag) <= hi) & (np.abs(s) > NEUTRAL_ROOT * scale)
+              & (np.abs(s.real) > UNDAMPED_ROOT * np.abs(s)))
+    pole, kappa_k = None, float("nan")
+    if inside.any():
+        with np.errstate(invalid="ignore", over="ignore"):
+            kappa = np.linalg.norm(modal.V[:, inside], axis=0) * np.linalg.norm(modal.W[inside], axis=1)
+            rounding = np.finfo(float).eps * kappa * scale
+            unresolved = ~(np.abs(s.real[inside]) > RESOLVED_DAMPING * rounding)
+        if unresolved.any():
+            k = int(np.flatnonzero(unresolved)[0])
+            pole, kappa_k = s[inside][k], float(kappa[k])
+    return _reasons(band, max_delay, ratio, all_finite, resonant, roots, wd, soft_root, pole, kappa_k)
+
+
+def _reasons(band: tuple[float, float], max_delay: float | None, ratio: float, all_finite: bool,
+             resonant: np.ndarray, roots: np.ndarray, wd: np.ndarray, soft_root: complex | None,
+             pole: complex | None, kappa: float) -> list[str]:
+    """The wording of why the cell maxima are not certified, from the checks' outcomes (empty when certified)."""
     why = []
     if max_delay is None:
         why.append("the forcing does not declare its delays")
@@ -367,31 +488,14 @@ def _uncertified(system: LinearSystem, modal, roots: np.ndarray, resonant: np.nd
         why.append(f"mode {j + 1} at {wd[j] / (2 * np.pi):.6g} Hz has damping ratio {abs(mode.real) / abs(mode):.3g} "
                    f"≤ {UNDAMPED_ROOT:g} (undamped to rounding): its peak is taken as unbounded, a finite one is "
                    "not resolved in double precision")
-    # neutral roots are taken as free rigid-body motion (s = 0 up to rounding: real pairs ±δ, or ±iδ on the axis); a
-    # complex pair among them damped beyond rounding is a genuine mode too soft for the search, whose peak is missed
-    s = modal.s
-    scale = float(np.max(np.abs(s), initial=0.0))
-    rounding = np.finfo(float).eps * scale
-    soft = (np.abs(s) <= NEUTRAL_ROOT * scale) & (s.imag != 0) & (-s.real > RESOLVED_DAMPING * rounding)
-    if soft.any():
-        root = s[soft][0]
+    if soft_root is not None:
+        root = soft_root
         why.append(f"the root s = {root.real:.3g}{root.imag:+.3g}i 1/s is below {NEUTRAL_ROOT:g}·max|s| (taken as "
                    "free rigid-body motion) yet damped beyond rounding: a mode too soft for the band search")
-    # a pole whose damping is within rounding of the eigenvalue: the grid, built around the computed pole, cannot
-    # be trusted to resolve the true peak (near-defective pairs, tiny damping)
-    inside = ((np.abs(s.imag) >= lo) & (np.abs(s.imag) <= hi) & (np.abs(s) > NEUTRAL_ROOT * scale)
-              & (np.abs(s.real) > UNDAMPED_ROOT * np.abs(s)))
-    if inside.any():
-        with np.errstate(invalid="ignore", over="ignore"):
-            kappa = np.linalg.norm(modal.V[:, inside], axis=0) * np.linalg.norm(modal.W[inside], axis=1)
-            rounding = np.finfo(float).eps * kappa * scale
-            unresolved = ~(np.abs(s.real[inside]) > RESOLVED_DAMPING * rounding)
-        if unresolved.any():
-            k = int(np.flatnonzero(unresolved)[0])
-            pole = s[inside][k]
-            why.append(f"the pole s = {pole.real:.6g}{pole.imag:+.6g}i 1/s has its damping within rounding of the "
-                       f"eigen-decomposition (eigenvalue condition {kappa[k]:.3g}; a defective or nearly repeated "
-                       "pair): the grid around it may not resolve the peak")
+    if pole is not None:
+        why.append(f"the pole s = {pole.real:.6g}{pole.imag:+.6g}i 1/s has its damping within rounding of the "
+                   f"eigen-decomposition (eigenvalue condition {kappa:.3g}; a defective or nearly repeated "
+                   "pair): the grid around it may not resolve the peak")
     return why
 
 
@@ -462,28 +566,21 @@ def _direct(system: LinearSystem, w: np.ndarray, cols: list[int]) -> np.ndarray:
     forcing evaluated for all Ω at once and only the outputs ``cols``; anything unusual (a callable term, a
     non-finite F or Z, a singular Z) goes to ``frf_outputs`` itself, which handles or names it."""
     forcing = system.forcing
-    if not forcing.is_polynomial:
-        return system.frf_outputs(omega_rad_s=w)[:, cols]
-    w = kernels.c_array(np.ravel(w))
-    F = forcing.values(w)
-    if not np.isfinite(F).all():
-        return system.frf_outputs(omega_rad_s=w)[:, cols]
-    try:
-        X, overflow = kernels.direct_solutions(kernels.c_array(system.M), kernels.c_array(system.C),
-                                               kernels.c_array(system.K), w, kernels.c_array(F, complex))
-    except np.linalg.LinAlgError:
-        return system.frf_outputs(omega_rad_s=w)[:, cols]
-    if overflow.any():
-        return system.frf_outputs(omega_rad_s=w)[:, cols]
     outputs = list(system.outputs.values())
     chosen = [outputs[c] for c in cols]
-    rows = np.array([o.row for o in chosen])
-    orders = np.array([o.order for o in chosen])
-    feed = 0.0 if all(o.feedthrough is None for o in chosen) else np.column_stack(
-        [o.feedthrough_values(w) for o in chosen])  # as LinearSystem._feedthroughs, for these outputs
-    with np.errstate(over="ignore", invalid="ignore"):
-        H = (X @ rows.T + feed) * (1j * w[:, None]) ** orders[None, :]
-    H[~np.isfinite(H)] = np.inf
+    if not forcing.is_polynomial or any(o.feedthrough is not None for o in chosen):
+        return system.frf_outputs(omega_rad_s=w)[:, cols]
+    w = kernels.c_array(np.ravel(w))
+    A, delays = forcing_arrays(forcing, system.n)
+    rows = kernels.c_array(np.array([o.row for o in chosen], dtype=float))
+    orders = np.array([o.order for o in chosen], dtype=np.int64)
+    try:  # the certified path's own direct-solve formula (the thesis values and the exact edges agree exactly)
+        H, status = kernels.direct_outputs(kernels.c_array(system.M), kernels.c_array(system.C),
+                                           kernels.c_array(system.K), w, A, delays, rows, orders)
+    except np.linalg.LinAlgError:
+        return system.frf_outputs(omega_rad_s=w)[:, cols]
+    if status:
+        return system.frf_outputs(omega_rad_s=w)[:, cols]
     return H
 
 
