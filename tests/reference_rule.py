@@ -62,7 +62,8 @@ def differences(fresh: pd.DataFrame, committed: pd.DataFrame) -> list[str]:
     out = []
     for column in committed.columns:
         a, b = fresh[column], committed[column]
-        if column == "grid_points" or pd.api.types.is_float_dtype(b) or pd.api.types.is_float_dtype(a):
+        numeric = all(pd.api.types.is_numeric_dtype(c) and not pd.api.types.is_bool_dtype(c) for c in (a, b))
+        if numeric and (column == "grid_points" or pd.api.types.is_float_dtype(b) or pd.api.types.is_float_dtype(a)):
             x, y = a.to_numpy(float), b.to_numpy(float)
             rtol, atol = ((0.0, CHANGE_ATOL) if _is_change(column) else (GRID_RTOL, 0.0) if column == "grid_points"
                           else (U_RTOL if column in U_COLUMNS else DESIGN_RTOL, 0.0))
@@ -71,8 +72,9 @@ def differences(fresh: pd.DataFrame, committed: pd.DataFrame) -> list[str]:
                     f"{abs(x[i] - y[i]) / max(abs(y[i]), 1e-300):.1e}; rtol {rtol:g}, atol {atol:g})"
                     for i in np.flatnonzero(bad)]
         elif not a.equals(b):
-            out += [f"{column}[{i}]: {a.iloc[i]!r} vs {b.iloc[i]!r} (exact)" for i in np.flatnonzero(
-                (a.astype(str) != b.astype(str)).to_numpy())]
+            both_empty = (a.isna() & b.isna()).to_numpy()
+            unequal = (a.astype(str) != b.astype(str)).to_numpy() & ~both_empty
+            out += [f"{column}[{i}]: {a.iloc[i]!r} vs {b.iloc[i]!r} (exact)" for i in np.flatnonzero(unequal)]
     return out
 
 

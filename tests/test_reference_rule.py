@@ -41,3 +41,9 @@ def test_changes_are_absolute_the_grid_size_within_5_percent_and_representative_
         _table(start_id=3).to_csv(tmp_path / f"{name}.csv", index=False)
     read = tables(tmp_path)
     assert "start_id" not in read["optima"] and "start_id" in read["starts"]
+
+
+def test_a_text_where_the_reference_had_none_is_a_difference():
+    base = pd.DataFrame({"message": [float("nan"), float("nan")]})  # an all-empty column reads as float
+    found = differences(pd.DataFrame({"message": [float("nan"), "maxeval=2000 reached"]}), base)
+    assert len(found) == 1 and found[0].startswith("message[1]")
