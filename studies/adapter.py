@@ -35,7 +35,7 @@ from railopt.design import DesignVariable, MinimaxProblem
 from railopt.models import LinearSystem
 from railopt.models.modal import growing_roots
 from railopt.models.random_response import RandomResponse, random_response, rms_gradient
-from railopt.models.response_maxima import all_response_maxima
+from railopt.models.response_maxima import all_response_maxima, batch_response_maxima
 from railopt.models.sensitivity import maxima_jacobians
 from railopt.models.stability_map import least_damping_ratio, stability_map, worst_speed
 from railopt.models.stability_rows import StabilityRows
@@ -284,6 +284,34 @@ class _Evaluator:
                              stability: StabilityTarget | None) -> np.ndarray:
         return np.vstack(self._constraint_parts(x, targets, stability, jacobian=True))
 
+    def batch_objective(self, X: np.ndarray, target: ResponseTarget) -> np.ndarray:
+        """The f_k of ``target`` at every row of X (B, d): (B, n + 2), the members stacked and their certified
+        maxima in one compiled call (:func:`~railopt.models.response_maxima.batch_response_maxima`); a row whose
+        parameters the model refuses (a ``ValueError``) is +inf, as :meth:`MinimaxProblem.values` takes a refused
+        point.  A family that cannot be stacked (a callable forcing term) is evaluated row by row (the same values)."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        out = np.full((len(X), self.setup.family.n + 2), np.inf)
+        kept, P = [], []
+        for b, x in enumerate(X):
+            try:
+                P.append(self.setup.parameters(self.names, x)[0])
+            except ValueError:
+                continue
+            kept.append(b)
+        if not kept:
+            return out
+        try:
+            stack = self.setup.family.stack(np.array(P))
+        except ValueError:  # callable forcing terms: no stacked form
+            for b in kept:
+                try:
+                    out[b] = self.maxima(X[b], [target])
+                except ValueError:
+                    pass
+            return out
+        out[kept] = batch_response_maxima(stack, band_rad_s=target.band, output=target.output)
+        return out
+
     def __getstate__(self) -> dict:  # ship to dask workers without the cached system
         return {"setup": self.setup, "names": self.names, "_key": None, "_sys": None, "_p": None, "_dp": None,
                 "_pieces": {}}
@@ -336,9 +364,12 @@ def minimax_problem(
         if objective.output not in setup.family.output_names:
             raise ValueError(f"objective.output: unknown output {objective.output!r}; outputs are "
                              f"{list(setup.family.output_names)}")
+    # the certified maxima of many designs at once (objective surfaces, grid scans): one compiled call per batch
+    batch = (None if not isinstance(objective, ResponseTarget) or not objective.exact
+             else lambda X: evaluator.batch_objective(X, objective))
     if not constraints and stability is None:
         return MinimaxProblem(list(variables), lambda x: evaluator.objective(x, objective),
-                              jacobian=lambda x: evaluator.objective_jacobian(x, objective))
+                              jacobian=lambda x: evaluator.objective_jacobian(x, objective), batch_functions=batch)
     if stability is not None:
         missing = [t for t in stability.tracks if t not in setup.stability]
         if missing:
@@ -358,6 +389,7 @@ def minimax_problem(
         constraint_jacobian=lambda x: evaluator.constraints_jacobian(x, targets, stability),
         epsilon=epsilon,
         refine=refine,
+        batch_functions=batch,
     )
 
 
