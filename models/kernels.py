@@ -822,7 +822,8 @@ def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray,
     A status ≠ 0 means the caller takes the general path.
 
     Returns (status, values (m, n+2), freqs (m, n+2), ratio, grid points, all samples finite, resonant (n,) bool,
-    soft root index into s (−1: none), unresolved pole index into s (−1: none), its eigenvalue condition, W, cond).
+    soft root index into s (−1: none), unresolved pole index into s (−1: none), its eigenvalue condition, W, cond,
+    the damped frequencies ω_d (n,) in mode order).
     An undamped mode inside the band (resonant) has value inf at its clipped ω_d.
     """
     undamped_root, neutral_root, zero_step, condition_limit = settings[0], settings[1], settings[2], settings[3]
@@ -851,16 +852,16 @@ def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray,
     nneutral, least = 0, math.inf
     for k in range(N):
         if s[k].real > undamped_root * abs(s[k]) and abs(s[k]) > neutral_root * scale:
-            return (CERT_UNSTABLE, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, math.inf)
+            return (CERT_UNSTABLE, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, math.inf, wd)
         if abs(s[k]) <= neutral_root * scale:
             nneutral += 1
         else:
             least = min(least, abs(s[k]))
     if scale > 0 and 0 < nneutral < N and lo < min(zero_step * least, 1e-3 * hi):
-        return (CERT_ZERO_ZONE, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, math.inf)
+        return (CERT_ZERO_ZONE, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, math.inf, wd)
     W, cond = left_vectors(V)
     if cond > condition_limit:
-        return (CERT_ILL_CONDITIONED, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, cond)
+        return (CERT_ILL_CONDITIONED, values, freqs, math.nan, 0, False, resonant, -1, -1, math.nan, W, cond, wd)
     # the grid's poles: not undamped (their cells are inf anyway)
     keep = np.zeros(N, np.bool_)
     for k in range(N):
@@ -890,7 +891,8 @@ def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray,
     pts[m * n], pts[m * n + 1] = lo, hi
     H, status = direct_outputs(M, C, K, pts, A, delays, rows, orders)
     if status:
-        return (CERT_NOT_FINITE, values, freqs, ratio, grid.size, all_finite, resonant, -1, -1, math.nan, W, cond)
+        return (CERT_NOT_FINITE, values, freqs, ratio, grid.size, all_finite, resonant, -1, -1, math.nan, W, cond,
+                wd)
     top = 0.0
     for o in range(m):
         for j in range(n):
@@ -907,7 +909,7 @@ def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray,
             f, d = cf[o, j], values[o, j]
             if math.isfinite(f) and math.isfinite(d) and abs(f - d) > consistency_rtol * max(top, 1e-300):
                 return (CERT_INCONSISTENT, values, freqs, ratio, grid.size, all_finite, resonant, -1, -1, math.nan,
-                        W, cond)
+                        W, cond, wd)
     for o in range(m):  # a maximiser found on the noisy sum (noise ≳ POLISH_RTOL) is located again on direct solves
         row = np.ascontiguousarray(rows[o:o + 1])
         order_o = orders[o:o + 1].copy()
@@ -945,7 +947,7 @@ def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray,
             kappa = math.sqrt(nv) * math.sqrt(nw)
             if not abs(s[k].real) > resolved * EPS * kappa * scale:
                 unresolved, kappa_u = k, kappa
-    return (CERT_OK, values, freqs, ratio, grid.size, all_finite, resonant, soft, unresolved, kappa_u, W, cond)
+    return (CERT_OK, values, freqs, ratio, grid.size, all_finite, resonant, soft, unresolved, kappa_u, W, cond, wd)
 
 
 @njit(**JIT)

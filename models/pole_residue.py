@@ -94,8 +94,10 @@ def forcing_arrays(forcing: Forcing, n: int) -> tuple[np.ndarray, np.ndarray]:
     in s."""
     poly = [t for t in forcing.terms if t.coefficients is not None]
     delays = np.array([t.delay for t in poly], dtype=float)
-    degree = max((t.coefficients.shape[0] for t in poly), default=1)
-    A = np.zeros((len(poly), degree, n), dtype=complex)  # every term's coefficients stacked
+    degrees = {t.coefficients.shape[0] for t in poly}
+    if len(degrees) == 1:  # every term of one degree (the usual case): one stacking copy
+        return np.array([t.coefficients for t in poly], dtype=complex), delays
+    A = np.zeros((len(poly), max(degrees, default=1), n), dtype=complex)  # every term's coefficients stacked
     for ti, t in enumerate(poly):
         A[ti, : t.coefficients.shape[0]] = t.coefficients
     return A, delays

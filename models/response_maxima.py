@@ -30,6 +30,7 @@ rigid-body motion, a delay whose grid would exceed :data:`MAX_GRID_POINTS`, a li
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -109,6 +110,20 @@ class ResponseMaxima(ArrayRecord):
     grid_points: int = 0
     reason: str = ""
 
+    @classmethod
+    def _owned(cls, values: np.ndarray, frequencies: np.ndarray, damped_frequencies: np.ndarray,
+               band: tuple[float, float], **fields: object) -> ResponseMaxima:
+        """The record from arrays nobody else holds (fresh from a kernel): made read-only in place, not copied."""
+        self = object.__new__(cls)
+        for name, value in (("values", values), ("frequencies", frequencies),
+                            ("damped_frequencies", damped_frequencies)):
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "band", band)
+        for f in dataclasses.fields(cls)[4:]:
+            object.__setattr__(self, f.name, fields.get(f.name, f.default))
+        return self
+
     @property
     def value(self) -> float:
         """U = max_k f_k (4.74)."""
@@ -164,9 +179,10 @@ def response_maxima(system: LinearSystem, band: object = None, *, band_hz: tuple
     Zero damping or a singular Z(Ω) gives ``inf`` entries (never NaN), so U = +inf and an
     optimiser can carry on.
     """
-    name = system.output_names[system.output_index(output)]
-    band_rad_s = band_arg(band, band_hz, band_rad_s)
-    return all_response_maxima(system, band_rad_s=band_rad_s, exact=exact, outputs=[name])[name]
+    col = system.output_index(output)
+    name = system.output_names[col]
+    lo, hi = band_arg(band, band_hz, band_rad_s)
+    return _maxima(system, lo, hi, exact, [name], [col])[name]
 
 
 def peak(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
@@ -189,7 +205,12 @@ def all_response_maxima(system: LinearSystem, band: object = None, *, band_hz: t
     """
     lo, hi = band_arg(band, band_hz, band_rad_s)
     names = list(system.output_names if outputs is None else outputs)
-    cols = [system.output_index(nm) for nm in names]
+    return _maxima(system, lo, hi, exact, names, [system.output_index(nm) for nm in names])
+
+
+def _maxima(system: LinearSystem, lo: float, hi: float, exact: bool, names: list[str],
+            cols: list[int]) -> dict[str, ResponseMaxima]:
+    """:func:`all_response_maxima` of a validated band (rad/s) and the outputs ``names`` (columns ``cols``)."""
     if exact:
         compiled = _certified(system, (lo, hi), names, cols)
         if compiled is not None:  # the common case: the whole exact path in one compiled call
@@ -415,29 +436,28 @@ def _certified(system: LinearSystem, band: tuple[float, float], names: list[str]
     if not system.forcing.is_polynomial or max_delay is None or any(o.feedthrough is not None for o in chosen):
         return None
     lo, hi = band
-    modal = system.modal()
+    s, V = system.eigen_pairs()
     A, delays = forcing_arrays(system.forcing, system.n)
     rows = kernels.c_array(np.array([o.row for o in chosen], dtype=float))
     orders = np.array([o.order for o in chosen], dtype=np.int64)
     count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points((lo, hi), max_delay), MAX_GRID_POINTS))
     try:
-        (status, values, freqs, ratio, points, all_finite, resonant, soft, unresolved, kappa, W,
-         condition) = kernels.certified_maxima(
+        (status, values, freqs, ratio, points, all_finite, resonant, soft, unresolved, kappa, W, condition,
+         wd) = kernels.certified_maxima(
             kernels.c_array(system.M), kernels.c_array(system.C), kernels.c_array(system.K),
-            kernels.c_array(modal.s, complex), kernels.c_array(modal.V, complex), A, delays, rows, orders,
+            kernels.c_array(s, complex), kernels.c_array(V, complex), A, delays, rows, orders,
             float(lo), float(hi), float(max_delay), int(count), _SETTINGS)
     except np.linalg.LinAlgError:  # V or a Z(Ω) exactly singular
         return None
     if W.size:
-        modal.remember_left(W, condition)
+        system.remember_left(W, condition)
     if status != kernels.CERT_OK:
         return None
-    roots = system.eigenvalues()
-    wd = np.abs(roots[1::2].imag)
-    why = _reasons(band, max_delay, ratio, all_finite, resonant, roots, wd,
-                   None if soft < 0 else modal.s[soft], None if unresolved < 0 else modal.s[unresolved], kappa)
-    return {nm: ResponseMaxima(values[i], freqs[i], wd, (lo, hi), exact=True, certified=not why, grid_ratio=ratio,
-                               output=nm, evaluation="pole-residue", grid_points=int(points), reason="; ".join(why))
+    why = _reasons(band, max_delay, ratio, all_finite, resonant, system.eigenvalues() if resonant.any() else s, wd,
+                   None if soft < 0 else s[soft], None if unresolved < 0 else s[unresolved], kappa)
+    return {nm: ResponseMaxima._owned(values[i], freqs[i], wd, (lo, hi), exact=True, certified=not why,
+                                      grid_ratio=float(ratio), output=nm, evaluation="pole-residue",
+                                      grid_points=int(points), reason="; ".join(why))
             for i, nm in enumerate(names)}
 
 

@@ -140,6 +140,8 @@ class LinearSystem:
             raise ValueError("M: is singular (a coordinate without inertia); eliminate it first")
         self._eigvals: np.ndarray | None = None
         self._modal: Modal | None = None
+        self._eig: tuple[np.ndarray, np.ndarray] | None = None  # (s, V) of np.linalg.eig before any Modal record
+        self._left: tuple[np.ndarray, float] | None = None  # (W, cond₁ V) worked out by the compiled path
         self._pole_residue: PoleResidue | None | bool = False  # False: not built yet
 
     # ------------------------------------------------------------------ properties
@@ -202,13 +204,36 @@ class LinearSystem:
     def modal(self) -> Modal:
         """Roots s of G with right (V) and left (W = V⁻¹) eigenvectors, cached (eqs. 4.56-4.58)."""
         if self._modal is None:
-            self._modal = modal(self.state_matrix())
+            self._modal = Modal(*self._eig) if self._eig is not None else modal(self.state_matrix())
+            if self._left is not None:
+                self._modal.remember_left(*self._left)
         return self._modal
+
+    def eigen_pairs(self) -> tuple[np.ndarray, np.ndarray]:
+        """(s (2n,), V (2n, 2n)) of ``np.linalg.eig(G)``, cached, without building the :class:`Modal` record (the
+        compiled certified path takes the arrays as they are); the same arrays :meth:`modal` then holds."""
+        if self._modal is not None:
+            return self._modal.s, self._modal.V
+        if self._eig is None:
+            self._eig = np.linalg.eig(self.state_matrix())
+        return self._eig
+
+    def remember_left(self, W: np.ndarray, condition: float) -> None:
+        """Keep W = V⁻¹ and cond₁(V) of :meth:`eigen_pairs` worked out by a compiled kernel, for :meth:`modal`."""
+        if self._modal is not None:
+            self._modal.remember_left(W, condition)
+        else:
+            self._left = (W, condition)
 
     def _roots(self) -> np.ndarray:
         """All 2n eigenvalues of G, unsorted, cached (vectors are computed only when asked for)."""
         if self._eigvals is None:
-            self._eigvals = self._modal.s if self._modal is not None else np.linalg.eigvals(self.state_matrix())
+            if self._modal is not None:
+                self._eigvals = self._modal.s
+            elif self._eig is not None:
+                self._eigvals = self._eig[0]
+            else:
+                self._eigvals = np.linalg.eigvals(self.state_matrix())
         return self._eigvals
 
     def eigenvalues(self) -> np.ndarray:

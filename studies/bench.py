@@ -54,7 +54,7 @@ from railopt.studies.kinds.campaign import campaign_problem
 from railopt.studies.output.markdown import markdown_table
 from railopt.studies.output.writer import Writer
 
-__all__ = ["BUSY_CEILING", "busy_marked", "random_chain", "run_bench"]
+__all__ = ["BUSY_CEILING", "busy_marked", "random_chain", "run_bench", "surface_row"]
 
 STUDIES = Path(__file__).resolve().parent
 
