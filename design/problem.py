@@ -248,32 +248,48 @@ class MinimaxProblem:
         return self.evaluate(x).value
 
     def values(self, X: Sequence[Sequence[float]] | np.ndarray) -> np.ndarray:
-        """U at each row of X (B, d): shape (B,); +inf where the model refuses a design (a ``ValueError`` of
-        ``functions``) or any f_k is not finite.  One call of ``batch_functions`` when given, else one
-        :meth:`value` per row.
+        """U = max_k f_k at each row of X (B, d): shape (B,); +inf where the model refuses a design (a
+        ``ValueError`` raised by ``functions``, or a row of +inf from ``batch_functions``) or any f_k is not finite.
+        One call of ``batch_functions`` when given, else ``functions`` row by row; the constraints are not
+        evaluated (a surface of U).
 
         Raises
         ------
         ValueError
-            If X is not (B, d), or ``batch_functions`` returns another shape than (B, m) or NaN.
+            If X is not (B, d); if f returns NaN, or a count m other than at other designs (either path); if
+            ``batch_functions`` returns another shape than (B, m).
         """
         X = np.asarray(X, dtype=float)
         if X.ndim != 2 or X.shape[1] != self.space.dim:
             raise ValueError(f"X: must have shape (B, {self.space.dim}), got {X.shape}")
         if self._batch_functions is None:
-            out = np.empty(len(X))
-            for b, x in enumerate(X):
-                try:
-                    out[b] = self.value(x)
+            rows = []
+            for x in X:
+                try:  # the model's own refusal of a design (a ValueError of ``functions``) is +inf ...
+                    v = self._functions(x)
                 except ValueError:
-                    out[b] = np.inf
-            return out
-        F = np.asarray(self._batch_functions(X), dtype=float)
-        if F.ndim != 2 or F.shape[0] != len(X) or (self.n_functions is not None and F.shape[1] != self.n_functions):
-            raise ValueError(f"batch_functions: must return shape ({len(X)}, m), got {F.shape}")
-        if np.any(np.isnan(F)):
-            raise ValueError("batch_functions: returned NaN (use +inf for a refused design)")
+                    rows.append(None)
+                    continue
+                rows.append(self._as_vector(v[0] if self._jacobian is True else v, "functions"))  # ... NaN is not
+            m = self._learn_function_count({len(r) for r in rows if r is not None}, "functions")
+            F = np.array([np.full(m, np.inf) if r is None else r for r in rows]).reshape(len(X), m)
+        else:
+            F = np.asarray(self._batch_functions(X), dtype=float)
+            if F.ndim != 2 or F.shape[0] != len(X):
+                raise ValueError(f"batch_functions: must return shape ({len(X)}, m), got {F.shape}")
+            if np.any(np.isnan(F)):
+                raise ValueError("batch_functions: returned NaN (use +inf for a refused design)")
+            self._learn_function_count({F.shape[1]}, "batch_functions")
         return np.where(np.all(np.isfinite(F), axis=1), np.max(F, axis=1), np.inf)
+
+    def _learn_function_count(self, counts: set[int], field: str) -> int:
+        """The one number m of values f has (learnt here when no evaluation fixed it yet); 0 when unknown."""
+        known = counts | ({self.n_functions} if self.n_functions is not None else set())
+        if len(known) > 1:
+            raise ValueError(f"{field}: returned {sorted(known)} values at different designs; the count must be fixed")
+        if known and self.n_functions is None:
+            self.n_functions = next(iter(known))
+        return self.n_functions or 0
 
     @property
     def has_batch(self) -> bool:

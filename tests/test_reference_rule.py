@@ -47,3 +47,12 @@ def test_a_text_where_the_reference_had_none_is_a_difference():
     base = pd.DataFrame({"message": [float("nan"), float("nan")]})  # an all-empty column reads as float
     found = differences(pd.DataFrame({"message": [float("nan"), "maxeval=2000 reached"]}), base)
     assert len(found) == 1 and found[0].startswith("message[1]")
+
+
+def test_a_peak_is_held_to_1e9_the_epigraph_variable_to_1e6_and_a_violation_to_1e9_absolute():
+    base = pd.DataFrame({"den_hartog_peak": [2.5], "t": [0.25], "constraint_violation": [0.0]})
+    assert differences(pd.DataFrame({"den_hartog_peak": [2.5], "t": [0.25 * (1 + 5e-7)],
+                                     "constraint_violation": [1e-20]}), base) == []
+    found = differences(pd.DataFrame({"den_hartog_peak": [2.5 * (1 + 5e-9)], "t": [0.25],
+                                      "constraint_violation": [2e-9]}), base)
+    assert [d.split("[")[0] for d in found] == ["den_hartog_peak", "constraint_violation"]

@@ -260,7 +260,8 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
             break
         if np.sign(new.tangent[-1]) != np.sign(here.tangent[-1]) and here.tangent[-1] != 0:
             try:
-                folds.append(_locate_fold(branch, here, new, h, rhs, coordinate, settings))
+                folds.append(_locate_fold(branch, here, new, h, (amplitudes[-1], amplitude), rhs, coordinate,
+                                            settings))
             except ValueError as error:
                 reason = (f"a fold between {here.u[-1] * options.speed_scale:.6g} and {speed:.6g} m/s could not "
                           f"be located: {error}")
@@ -296,12 +297,13 @@ def continue_periodic_orbit(rhs: RightHandSide, orbit: PeriodicOrbit, section: P
         linear_critical_speed=float(linear_critical_speed))
 
 
-def _locate_fold(branch: _Branch, here: _Point, new: _Point, h: float, rhs: RightHandSide,
-                 coordinate: Coordinate, settings: IntegrationSettings) -> Fold:
-    """Brent's method on the arclength s ∈ (0, h) for a zero of the tangent's speed component; the cubic Hermite
-    extremum through ``here`` and ``new`` when the corrector fails inside the step (see the module docstring)."""
+def _locate_fold(branch: _Branch, here: _Point, new: _Point, h: float, amplitudes: tuple[float, float],
+                 rhs: RightHandSide, coordinate: Coordinate, settings: IntegrationSettings) -> Fold:
+    """Brent's method on the arclength s ∈ (0, h) for a zero of the tangent's speed component; when the corrector
+    fails inside the step, the cubic Hermite extremum through the closest pair of corrected points around the turn
+    (``here``, ``new`` and Brent's points so far; see the module docstring).  ``amplitudes``: the watched
+    coordinate's amplitude at ``here`` and ``new``."""
     cache: dict[float, _Point] = {}
-    between = (float(here.u[-1] * branch.scale[-1]), float(new.u[-1] * branch.scale[-1]))
 
     def speed_component(s: float) -> float:
         if s == 0.0:
@@ -317,17 +319,33 @@ def _locate_fold(branch: _Branch, here: _Point, new: _Point, h: float, rhs: Righ
             raise ValueError("fold: the tangent's speed component has the same sign at both ends of the step")
         s_fold = brentq(speed_component, 0.0, h, xtol=1e-12 * h, rtol=4 * np.finfo(float).eps)
     except _CorrectorFailed:
-        speed_scaled, w = hermite_turn(here.u, here.tangent, new.u, new.tangent)
-        x = branch.section.place((1 - w) * here.u[:-1] * branch.scale[:-1] + w * new.u[:-1] * branch.scale[:-1],
-                                 branch.n)
-        speed = float(speed_scaled * branch.scale[-1])
-        period = (1 - w) * here.period + w * new.period
-        amplitude = orbit_amplitude(rhs, x, speed, period, coordinate, settings)
-        return Fold(speed, amplitude, period, x, located="hermite", between=between)
+        return _hermite_fold(branch, here, new, h, amplitudes, cache, rhs, coordinate, settings)
     point = cache.get(s_fold) or branch.correct(here.u + s_fold * here.tangent, here.tangent, here.period)
     x, speed = branch.state(point.u)
     amplitude = orbit_amplitude(rhs, x, speed, point.period, coordinate, settings)
+    between = (float(here.u[-1] * branch.scale[-1]), float(new.u[-1] * branch.scale[-1]))
     return Fold(float(speed), amplitude, point.period, x, located="brent", between=between)
+
+
+def _hermite_fold(branch: _Branch, here: _Point, new: _Point, h: float, amplitudes: tuple[float, float],
+                  cache: dict[float, _Point], rhs: RightHandSide, coordinate: Coordinate,
+                  settings: IntegrationSettings) -> Fold:
+    """The fold from :func:`hermite_turn` on the closest pair of corrected points whose tangents' speed components
+    change sign; the point on the section, period and amplitude interpolated linearly between that pair."""
+    known = {0.0: (here, amplitudes[0]), **{s: (p, math.nan) for s, p in cache.items() if s != h},
+             h: (new, amplitudes[1])}
+    ordered = sorted(known.items())
+    pairs = [(a, b) for a, b in zip(ordered, ordered[1:], strict=False)
+             if a[1][0].tangent[-1] * b[1][0].tangent[-1] <= 0]
+    (s0, (p0, a0)), (s1, (p1, a1)) = min(pairs, key=lambda pair: pair[1][0] - pair[0][0])
+    speed_scaled, w = hermite_turn(p0.u, p0.tangent, p1.u, p1.tangent)
+    scale = branch.scale
+    x = branch.section.place(((1 - w) * p0.u[:-1] + w * p1.u[:-1]) * scale[:-1], branch.n)
+    amplitude_at = [a if math.isfinite(a) else orbit_amplitude(rhs, *branch.state(p.u), p.period, coordinate,
+                                                                settings) for p, a in ((p0, a0), (p1, a1))]
+    return Fold(float(speed_scaled * scale[-1]), (1 - w) * amplitude_at[0] + w * amplitude_at[1],
+                (1 - w) * p0.period + w * p1.period, x, located="hermite",
+                between=(float(p0.u[-1] * scale[-1]), float(p1.u[-1] * scale[-1])))
 
 
 class _CorrectorFailed(Exception):
@@ -365,8 +383,9 @@ def hermite_turn(u0: np.ndarray, t0: np.ndarray, u1: np.ndarray, t1: np.ndarray)
     v0, v1 = float(u0[-1]), float(u1[-1])
     # V(w) on w = s/L ∈ [0, 1]: Hermite basis with slopes m0 = L·d0, m1 = L·d1; V'(w) = a w² + b w + c
     m0, m1 = length * d0, length * d1
-    a = 6 * v0 + 3 * m0 - 6 * v1 + 3 * m1
-    b = -6 * v0 - 4 * m0 + 6 * v1 - 2 * m1
+    dv = v1 - v0  # differenced once: the coefficients then keep their accuracy when v0 ≈ v1 are large
+    a = -6 * dv + 3 * (m0 + m1)
+    b = 6 * dv - 4 * m0 - 2 * m1
     c = m0
     if abs(a) <= 1e-14 * (abs(b) + abs(c)):
         roots = [-c / b] if b != 0 else [0.0]
@@ -378,8 +397,8 @@ def hermite_turn(u0: np.ndarray, t0: np.ndarray, u1: np.ndarray, t1: np.ndarray)
     if w is None:
         raise ValueError("hermite_turn: no turn of the cubic inside the step")
     w = min(max(w, 0.0), 1.0)
-    h00, h10, h01, h11 = 2 * w**3 - 3 * w**2 + 1, w**3 - 2 * w**2 + w, -2 * w**3 + 3 * w**2, w**3 - w**2
-    return h00 * v0 + h10 * m0 + h01 * v1 + h11 * m1, w
+    h10, h01, h11 = w**3 - 2 * w**2 + w, -2 * w**3 + 3 * w**2, w**3 - w**2
+    return v0 + h01 * dv + h10 * m0 + h11 * m1, w  # h00 + h01 = 1
 
 
 __all__ = [

@@ -36,12 +36,13 @@ class Fold(ArrayRecord):
     located : str
         How the speed was found: ``"brent"`` — the zero of the tangent's speed component, each trial point
         corrected onto the branch (as accurate as the corrector); ``"hermite"`` — the corrector failed inside the
-        step (a non-smooth map: contact tables), so the speed is the extremum of the cubic Hermite interpolant
-        of V(s) through the two corrected points around the turn and their tangents (error O(L⁴), L the chord),
-        and ``amplitude``, ``period`` and ``point`` are interpolated between those two points.
+        step (a non-smooth map: contact tables), so the speed is the extremum of the cubic Hermite interpolant of
+        V(s) through the closest pair of corrected points around the turn and their tangents (error O(L⁴) in the
+        chord L where the branch is smooth between them), and ``amplitude``, ``period`` and ``point`` are
+        interpolated linearly between that pair (``point`` is then near, not on, the fold's orbit).
     between : (float, float)
-        Speeds of the two corrected branch points around the turn (m/s); a fold to lower speeds lies at or below
-        both.
+        Speeds of the two corrected branch points around the turn that located it (m/s); a fold to lower speeds
+        lies at or below both.
     """
 
     speed: float

@@ -93,3 +93,27 @@ def test_batch_values_refuse_malformed_shapes_and_nan():
                                  constraints=lambda x: x[:1]).with_epsilon(0.5)
     assert constrained.has_batch
     np.testing.assert_array_equal(constrained.values([[0.2, 0.7], [0.9, 0.1]]), [0.7, 0.9])
+    wrong_count = MinimaxProblem(v, lambda x: x.copy(), batch_functions=lambda X: np.ones((len(X), 5)))
+    wrong_count.evaluate([0.1, 0.2])  # m = 2 learnt
+    with pytest.raises(ValueError, match="count must be fixed"):
+        wrong_count.values(np.zeros((2, 2)))
+
+
+def test_row_by_row_and_batched_values_agree_on_refusals_nan_counts_and_constraints():
+    v = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0)]
+
+    def refusing_constraint(x):
+        raise ValueError("the constraint model refuses every design")
+
+    plain = MinimaxProblem(v, lambda x: x.copy(), constraints=refusing_constraint)
+    batched = MinimaxProblem(v, lambda x: x.copy(), constraints=refusing_constraint, batch_functions=lambda X: X)
+    X = np.array([[0.2, 0.7], [0.9, 0.1]])
+    np.testing.assert_array_equal(plain.values(X), [0.7, 0.9])  # U alone: the constraints are not evaluated
+    np.testing.assert_array_equal(batched.values(X), [0.7, 0.9])
+    for nan_problem in (MinimaxProblem(v, lambda x: np.array([np.nan, 1.0])),
+                        MinimaxProblem(v, lambda x: x, batch_functions=lambda X: np.full_like(X, np.nan))):
+        with pytest.raises(ValueError, match="NaN"):
+            nan_problem.values(X)
+    changing = MinimaxProblem(v, lambda x: np.ones(2 if x[0] < 0.5 else 3))
+    with pytest.raises(ValueError, match="count must be fixed"):
+        changing.values(X)

@@ -217,3 +217,50 @@ def test_a_fold_the_corrector_cannot_bracket_is_located_by_hermite_and_marked(mo
     assert fold.speed == pytest.approx(V_FOLD, abs=5e-3)  # m/s; measured 1.8e-4 (the chord was 0.09 m/s)
     assert fold.amplitude == pytest.approx(math.sqrt(0.5), rel=2e-3)  # measured 2.9e-4
     assert diagram.to_pandas().attrs["fold_located"] == ["hermite"]
+
+
+def test_hermite_turn_finds_every_turn_of_random_steps_far_from_the_origin():
+    """Random steps (points up to 100 from the origin, chords down to 1e-8, speed slopes down to 1e-12) with the
+    speed component changing sign: a turn always lies inside, at or below both ends.  The coefficients are formed
+    from v1 − v0; formed from v0 and v1 separately they pushed about 1 % of these turns out of [0, 1] by round-off
+    (review finding)."""
+    rng = np.random.default_rng(0)
+    for _ in range(3000):
+        u0 = rng.normal(size=3) * 10 ** rng.uniform(-6, 2, size=3)
+        u1 = u0 + rng.normal(size=3) * 10 ** rng.uniform(-8, 1)
+        t0, t1 = rng.normal(size=3), rng.normal(size=3)
+        t0, t1 = t0 / np.linalg.norm(t0), t1 / np.linalg.norm(t1)
+        t0[-1], t1[-1] = -abs(t0[-1]) * 10 ** rng.uniform(-12, 0), abs(t1[-1]) * 10 ** rng.uniform(-12, 0)
+        value, w = hermite_turn(u0, t0, u1, t1)
+        assert 0.0 <= w <= 1.0
+        assert value <= min(u0[-1], u1[-1]) + 1e-12 * max(abs(u0[-1]), abs(u1[-1]))
+
+
+def test_a_fold_whose_bisection_fails_midway_uses_the_closest_corrected_pair(monkeypatch):
+    """Brent corrects some trial points before the corrector fails: the Hermite turn then uses the closest pair of
+    corrected points around the turn, not the whole step — a tighter pair and a closer fold."""
+    from railopt.models.bifurcation import continuation
+
+    def halfway_brentq(fun, a, b, **kwargs):
+        for s in (a + 0.5 * (b - a), a + 0.25 * (b - a), a + 0.75 * (b - a)):
+            fun(s)  # corrected and kept, as Brent's own trial points
+        raise continuation._CorrectorFailed(0.6 * b)
+
+    def whole_step_brentq(fun, a, b, **kwargs):
+        raise continuation._CorrectorFailed(0.5 * (a + b))
+
+    folds = {}
+    for name, fake in (("halfway", halfway_brentq), ("whole", whole_step_brentq)):
+        monkeypatch.setattr(continuation, "brentq", fake)
+        start = find_periodic_orbit(rhs, np.array([1.05, 0.0]), 33.0, SECTION, PERIOD, 0)
+        diagram = continue_periodic_orbit(rhs, start, SECTION, 0, speed_range=(20.0, 34.0),
+                                          options=ContinuationOptions(speed_scale=V_REF, points_after_fold=2),
+                                          shooting=ShootingOptions(min_amplitude=0.05))
+        folds[name] = diagram.folds[0]
+    half, whole = folds["halfway"], folds["whole"]
+    assert half.located == whole.located == "hermite"
+    assert max(half.between) - V_FOLD < max(whole.between) - V_FOLD  # a closer pair around the turn
+    assert half.speed <= min(half.between)
+    assert abs(half.speed - V_FOLD) < abs(whole.speed - V_FOLD)
+    assert half.speed == pytest.approx(V_FOLD, abs=2e-5)  # m/s
+    assert half.amplitude == pytest.approx(math.sqrt(0.5), rel=2e-3)
