@@ -125,3 +125,31 @@ def test_one_call_values_equal_dense_solves_on_a_delayed_chain():
         # each value is |H| at its reported frequency (a direct solve here)
         for j in range(n + 2):
             assert abs(values[o, j] - mag(freqs[o, j], o)) <= 1e-12 * values[o].max()
+
+
+def test_a_member_with_an_exactly_singular_impedance_takes_the_general_path():
+    """Undamped two-mass system, ω = 1 and 2 rad/s, band [0.5, 2]: Z(2) = K − 4M is exactly singular at the upper
+    edge, so the compiled call raises inside the batch (status −2) and that member is recomputed on the general path:
+    its values are the single path's (inf at both undamped peaks and at the edge, |H(0.5)| = 1/0.75 + 1/3.75 = 1.6
+    at the lower edge, the closed form of two uncoupled unit masses); the damped member beside it is unaffected."""
+    from railopt.models import ParametricSystem
+    from railopt.models.parametric import ParameterPart
+    from railopt.models.response_maxima import _SETTINGS
+
+    family = ParametricSystem(np.eye(2), np.zeros((2, 2)), np.diag([1.0, 4.0]), F0=[1.0, 1.0], output=[1.0, 1.0],
+                              parts={"c": ParameterPart(C=np.eye(2))})
+    P = np.array([[0.0], [0.1]])
+    stack = family.stack(P)
+    G, regular = kernels.state_matrices(stack.M, stack.C, stack.K, 1e-14)
+    s, V = np.linalg.eig(G)
+    status = kernels.certified_maxima_batch(stack.M, stack.C, stack.K, np.ascontiguousarray(s), np.ascontiguousarray(V),
+                                            np.ascontiguousarray(stack.coefficients), stack.delays,
+                                            np.array([[1.0, 1.0]]), np.array([0]), 0.5, 2.0, 0.0, 33, _SETTINGS,
+                                            regular)[0]
+    assert status.tolist() == [-2, kernels.CERT_OK]
+    with np.errstate(invalid="ignore"):
+        values = batch_response_maxima(stack, band_rad_s=(0.5, 2.0))
+        for b, p in enumerate(P):
+            alone = all_response_maxima(family.at(p), band_rad_s=(0.5, 2.0), exact=True)["output"]
+            np.testing.assert_allclose(values[b], alone.values, rtol=1e-12, atol=0)
+    assert np.isinf(values[0, [0, 1, 3]]).all() and values[0, 2] == pytest.approx(1 / 0.75 + 1 / 3.75, rel=1e-14)
