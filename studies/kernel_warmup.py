@@ -14,20 +14,32 @@ import time
 
 import numpy as np
 
-from railopt.models import LinearSystem
+from railopt.models import LinearSystem, ParameterPart, ParametricSystem
+from railopt.models.response_maxima import batch_response_maxima
+from railopt.models.sensitivity import maxima_jacobians
 
 __all__ = ["warm_kernels"]
 
 
 def warm_kernels(show_progress: bool = True) -> float:
-    """Run the certified and the thesis-method band maximum of a 2-DOF system once (compiles or loads every
-    kernel of those paths); returns the seconds it took.  Prints one line to stderr when it took over 2 s
-    (a cold cache) and ``show_progress``."""
+    """Run what a campaign's tasks run on a 2-DOF system once — the certified and the thesis-method band maximum,
+    a frequency response, the pole–residue sums, the maxima's gradients and a batch of designs (objective-surface
+    rows) — so that every kernel of those paths is
+    compiled or loaded; returns the seconds it took.  Prints one line to stderr when it took over 2 s (a cold
+    cache) and ``show_progress``."""
     t = time.perf_counter()
-    system = LinearSystem(np.diag([1.0, 2.0]), np.array([[0.3, -0.1], [-0.1, 0.2]]),
-                          np.array([[3.0, -1.0], [-1.0, 2.0]]), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    M, C, K = np.diag([1.0, 2.0]), np.array([[0.3, -0.1], [-0.1, 0.2]]), np.array([[3.0, -1.0], [-1.0, 2.0]])
+    system = LinearSystem(M, C, K, np.array([1.0, 0.0]), np.array([0.0, 1.0]))
     system.response_maxima(band_rad_s=(0.0, 4.0), exact=True)
     system.response_maxima(band_rad_s=(0.0, 4.0))
+    system.frf(omega_rad_s=np.linspace(0.1, 4.0, 5))
+    family = ParametricSystem(M, C, K, np.array([1.0, 0.0]), np.array([0.0, 1.0]),
+                              {"k": ParameterPart(K=np.diag([1.0, 0.0]))}, values=[0.5])
+    batch_response_maxima(family.stack(np.array([[0.5], [1.0]])), band_rad_s=(0.0, 4.0))
+    member = family.at([0.5])
+    member.pole_residue().evaluate(np.linspace(0.1, 4.0, 5))
+    for exact in (True, False):  # the gradients of a start
+        maxima_jacobians(member, band_rad_s=(0.0, 4.0), exact=exact)
     seconds = time.perf_counter() - t
     if show_progress and seconds > 2.0:
         print(f"compiled the numerical kernels in {seconds:.0f} s (cached on disk for the workers and later runs)",
