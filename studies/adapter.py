@@ -291,13 +291,16 @@ class _Evaluator:
         point.  A family that cannot be stacked (a callable forcing term) is evaluated row by row (the same values)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         out = np.full((len(X), self.setup.family.n + 2), np.inf)
-        kept, P = [], []
-        for b, x in enumerate(X):
-            try:
-                P.append(self.setup.parameters(self.names, x)[0])
-            except ValueError:
-                continue
-            kept.append(b)
+        try:
+            P, kept = self.setup.parameter_map.rows(self.names, X), list(range(len(X)))
+        except ValueError:  # a derived variable's transform refuses some row: find which, row by row
+            kept, P = [], []
+            for b, x in enumerate(X):
+                try:
+                    P.append(self.setup.parameters(self.names, x)[0])
+                except ValueError:
+                    continue
+                kept.append(b)
         if not kept:
             return out
         try:

@@ -94,6 +94,21 @@ class ParameterMap:
             if limit is not None and not value >= limit[0]:
                 raise ValueError(f"{where}.{name}: a {limit[1]} cannot be below {limit[0]:g}, got {value:g}")
 
+    def rows(self, names: Sequence[str], X: np.ndarray) -> np.ndarray:
+        """Parameter vectors (B, P) for the designs in the rows of X (B, d): row b equals ``self(names, X[b])[0]``
+        (the values only).  Direct variables (ids and aliases) fill their columns at once; a map with derived
+        variables goes row by row (the transform takes one design)."""
+        X = np.asarray(X, dtype=float)
+        if any(n in self.derived for n in names):
+            return np.array([self(names, x)[0] for x in X]).reshape(len(X), len(self.parameters))
+        params = list(self.parameters)
+        P = np.repeat(np.array(self.defaults, dtype=float)[None, :], len(X), axis=0)
+        for j, n in enumerate(names):
+            n = self.aliases.get(n, n)
+            if n in params:
+                P[:, params.index(n)] = X[:, j]
+        return P
+
     def __call__(self, names: Sequence[str], x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Parameter vector p (P,) for design values ``x`` of ``names``, and dp/dx (P, d)."""
         params = list(self.parameters)
