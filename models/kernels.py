@@ -930,12 +930,27 @@ def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray,
                 values[o, j], freqs[o, j] = math.inf, clipped[j]
             else:
                 freqs[o, j] = cx[o, j]
-    # the roots too soft for the search, and a pole whose damping is within the rounding of its eigenvalue
+    soft, unresolved, kappa_u = weak_roots(s, V, W, lo, hi, neutral_root, undamped_root, resolved)
+    return (CERT_OK, values, freqs, ratio, grid.size, all_finite, resonant, soft, unresolved, kappa_u, W, cond, wd)
+
+
+@njit(**JIT)
+def weak_roots(s: np.ndarray, V: np.ndarray, W: np.ndarray, lo: float, hi: float, neutral_root: float,
+               undamped_root: float, resolved: float) -> tuple[int, int, float]:
+    """The roots the band search cannot trust (:mod:`railopt.models.response_maxima`'s certificate): the first root
+    below ``neutral_root``·max|s| (taken as free rigid-body motion) that is complex and damped beyond
+    ``resolved``·ε·max|s| (a mode too soft for the search), and the first pole with ω inside [lo, hi], neither
+    neutral nor undamped, whose damping is within ``resolved``·ε·κ_k·max|s| of zero, κ_k = ‖v_k‖‖w_k‖ its eigenvalue
+    condition (the grid around it may not resolve the peak).  s (N,), V (N, N) right eigenvectors, W = V⁻¹ (rows
+    left).  Returns (soft index, unresolved index, its κ); −1 and NaN where there is none."""
+    N = s.size
+    scale = 0.0
+    for k in range(N):
+        scale = max(scale, abs(s[k]))
     soft, unresolved, kappa_u = -1, -1, math.nan
-    rounding = EPS * scale
     for k in range(N):
         if (soft < 0 and abs(s[k]) <= neutral_root * scale and s[k].imag != 0
-                and -s[k].real > resolved * rounding):
+                and -s[k].real > resolved * EPS * scale):
             soft = k
         inside = (abs(s[k].imag) >= lo and abs(s[k].imag) <= hi and abs(s[k]) > neutral_root * scale
                   and abs(s[k].real) > undamped_root * abs(s[k]))
@@ -947,7 +962,7 @@ def certified_maxima(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray,
             kappa = math.sqrt(nv) * math.sqrt(nw)
             if not abs(s[k].real) > resolved * EPS * kappa * scale:
                 unresolved, kappa_u = k, kappa
-    return (CERT_OK, values, freqs, ratio, grid.size, all_finite, resonant, soft, unresolved, kappa_u, W, cond, wd)
+    return soft, unresolved, kappa_u
 
 
 @njit(**JIT)
@@ -1012,5 +1027,5 @@ __all__ = [
     "direct_outputs", "direct_solutions", "forcing_values", "mode_order", "drop_falling_edges", "dual",
     "edge_probes", "left_vectors", "log_or_value", "magnitudes", "member_state", "pole_residue_magnitudes",
     "pole_residue_sums", "refine_cells", "residues", "state_matrices", "take_better",
-    "vertex_points", "vertex_run", "vertex_start", "vertex_update",
+    "vertex_points", "vertex_run", "vertex_start", "vertex_update", "weak_roots",
 ]

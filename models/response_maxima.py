@@ -403,7 +403,7 @@ def batch_response_maxima(stack: MemberStack, band: object = None, *, band_hz: t
         s, V = np.linalg.eig(G)
         delays = kernels.c_array(stack.delays)
         max_delay = float(np.max(delays, initial=0.0))
-        count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points((lo, hi), max_delay), MAX_GRID_POINTS))
+        count = _grid_count((lo, hi), max_delay)
         status, values, *_ = kernels.certified_maxima_batch(
             M, C, K, kernels.c_array(s, complex), kernels.c_array(V, complex),
             kernels.c_array(stack.coefficients, complex), delays, kernels.c_array(np.atleast_2d(chosen.row)),
@@ -440,7 +440,7 @@ def _certified(system: LinearSystem, band: tuple[float, float], names: list[str]
     A, delays = forcing_arrays(system.forcing, system.n)
     rows = kernels.c_array(np.array([o.row for o in chosen], dtype=float))
     orders = np.array([o.order for o in chosen], dtype=np.int64)
-    count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points((lo, hi), max_delay), MAX_GRID_POINTS))
+    count = _grid_count((lo, hi), max_delay)
     try:
         (status, values, freqs, ratio, points, all_finite, resonant, soft, unresolved, kappa, W, condition,
          wd) = kernels.certified_maxima(
@@ -464,27 +464,16 @@ def _certified(system: LinearSystem, band: tuple[float, float], names: list[str]
 def _uncertified(system: LinearSystem, modal, roots: np.ndarray, resonant: np.ndarray, wd: np.ndarray,
                  band: tuple[float, float], max_delay: float | None, ratio: float, all_finite: bool) -> list[str]:
     """Why the cell maxima are not certified (empty when they are), common to every output."""
-    lo, hi = band
     # neutral roots are taken as free rigid-body motion (s = 0 up to rounding: real pairs ±δ, or ±iδ on the axis); a
-    # complex pair among them damped beyond rounding is a genuine mode too soft for the search, whose peak is missed
-    s = modal.s
-    scale = float(np.max(np.abs(s), initial=0.0))
-    rounding = np.finfo(float).eps * scale
-    soft = (np.abs(s) <= NEUTRAL_ROOT * scale) & (s.imag != 0) & (-s.real > RESOLVED_DAMPING * rounding)
-    soft_root = s[soft][0] if soft.any() else None
+    # complex pair among them damped beyond rounding is a genuine mode too soft for the search, whose peak is missed;
     # a pole whose damping is within rounding of the eigenvalue: the grid, built around the computed pole, cannot
-    # be trusted to resolve the true peak (near-defective pairs, tiny damping)
-    inside = ((np.abs(s.imag) >= lo) & (np.abs(s.imag) <= hi) & (np.abs(s) > NEUTRAL_ROOT * scale)
-              & (np.abs(s.real) > UNDAMPED_ROOT * np.abs(s)))
-    pole, kappa_k = None, float("nan")
-    if inside.any():
-        with np.errstate(invalid="ignore", over="ignore"):
-            kappa = np.linalg.norm(modal.V[:, inside], axis=0) * np.linalg.norm(modal.W[inside], axis=1)
-            rounding = np.finfo(float).eps * kappa * scale
-            unresolved = ~(np.abs(s.real[inside]) > RESOLVED_DAMPING * rounding)
-        if unresolved.any():
-            k = int(np.flatnonzero(unresolved)[0])
-            pole, kappa_k = s[inside][k], float(kappa[k])
+    # be trusted to resolve the true peak (near-defective pairs, tiny damping) — the kernel's own check
+    s = modal.s
+    soft, unresolved, kappa_k = kernels.weak_roots(
+        kernels.c_array(s, complex), kernels.c_array(modal.V, complex), kernels.c_array(modal.W, complex),
+        float(band[0]), float(band[1]), NEUTRAL_ROOT, UNDAMPED_ROOT, RESOLVED_DAMPING)
+    soft_root = s[soft] if soft >= 0 else None
+    pole = s[unresolved] if unresolved >= 0 else None
     return _reasons(band, max_delay, ratio, all_finite, resonant, roots, wd, soft_root, pole, kappa_k)
 
 
@@ -517,6 +506,12 @@ def _reasons(band: tuple[float, float], max_delay: float | None, ratio: float, a
                    f"eigen-decomposition (eigenvalue condition {kappa:.3g}; a defective or nearly repeated "
                    "pair): the grid around it may not resolve the peak")
     return why
+
+
+def _grid_count(band: tuple[float, float], max_delay: float) -> int:
+    """Points of the uniform part of the band grid: the delay rule's (:func:`_delay_points`), at least
+    4·MIN_CELL_SAMPLES + 1, at most MAX_GRID_POINTS (beyond it the grid is not certified)."""
+    return max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points(band, max_delay), MAX_GRID_POINTS))
 
 
 def _delay_points(band: tuple[float, float], max_delay: float) -> int:
@@ -624,7 +619,7 @@ def band_grid(poles: np.ndarray, band: tuple[float, float], max_delay: float = 0
     compiled kernel is :func:`railopt.models.kernels.band_grid`.
     """
     lo, hi = float(band[0]), float(band[1])
-    count = max(4 * MIN_CELL_SAMPLES + 1, min(_delay_points((lo, hi), max_delay), MAX_GRID_POINTS))
+    count = _grid_count((lo, hi), max_delay)
     extra = np.zeros(0) if extra is None else kernels.c_array(np.ravel(extra))
     grid, ratio = kernels.band_grid(kernels.c_array(np.ravel(poles), complex), lo, hi,
                                     float(max_delay), extra, int(count), GRID_FACTOR, POLE_STEP, MAX_GRID_POINTS)

@@ -23,16 +23,19 @@ __all__ = ["warm_kernels"]
 
 def warm_kernels(show_progress: bool = True) -> float:
     """Run what a campaign's tasks run on a 2-DOF system once — the certified and the thesis-method band maximum,
-    a frequency response, the pole–residue sums, the maxima's gradients and a batch of designs (objective-surface
-    rows) — so that every kernel of those paths is
-    compiled or loaded; returns the seconds it took.  Prints one line to stderr when it took over 2 s (a cold
-    cache) and ``show_progress``."""
+    a frequency response, the general path (a free rigid-body mode), the pole–residue sums, the maxima's
+    gradients and a batch of designs (objective-surface rows) — so that every kernel of those paths is compiled
+    or loaded; returns the seconds it took.  Prints one line to stderr when it took over 2 s (a cold cache) and
+    ``show_progress``."""
     t = time.perf_counter()
     M, C, K = np.diag([1.0, 2.0]), np.array([[0.3, -0.1], [-0.1, 0.2]]), np.array([[3.0, -1.0], [-1.0, 2.0]])
     system = LinearSystem(M, C, K, np.array([1.0, 0.0]), np.array([0.0, 1.0]))
     system.response_maxima(band_rad_s=(0.0, 4.0), exact=True)
     system.response_maxima(band_rad_s=(0.0, 4.0))
     system.frf(omega_rad_s=np.linspace(0.1, 4.0, 5))
+    free = np.array([[1.0, -1.0], [-1.0, 1.0]])  # a free rigid-body mode: the general path (the zero zone)
+    LinearSystem(np.eye(2), 0.1 * free, free, np.array([1.0, 0.0]), np.array([0.0, 1.0]),
+                 response="acceleration").response_maxima(band_rad_s=(0.0, 4.0), exact=True)
     family = ParametricSystem(M, C, K, np.array([1.0, 0.0]), np.array([0.0, 1.0]),
                               {"k": ParameterPart(K=np.diag([1.0, 0.0]))}, values=[0.5])
     batch_response_maxima(family.stack(np.array([[0.5], [1.0]])), band_rad_s=(0.0, 4.0))
