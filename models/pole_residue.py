@@ -41,7 +41,6 @@ class PoleResidue:
         self._R, self._B = residues(c_array(M), V, c_array(decomposition.W, complex), c_array(rows), A)
         self._Cv = rows @ V[: M.shape[0]]  # (m, 2n)
 
-
     def kernel_data(self, output: int) -> tuple | None:
         """``(poles, R, output, delays, q)`` for the compiled |H_output| of
         :func:`railopt.models.kernels.pole_residue_magnitudes` (and the compiled cell search), or ``None`` when

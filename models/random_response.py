@@ -324,7 +324,7 @@ def rms_gradient(system: LinearSystem, response: RandomResponse, dp: np.ndarray 
     w = response.rule.omega
     q = {"displacement": 0, "velocity": 1, "acceleration": 2}[out.quantity]
     F = system.forcing.values(w)  # (N, n)
-    Z = system.K[None] - w[:, None, None] ** 2 * system.M[None] + 1j * w[:, None, None] * system.C[None]
+    Z = system.impedance(w)
     X = np.linalg.solve(Z, F[..., None])[..., 0]
     adj = np.linalg.solve(np.swapaxes(Z, 1, 2), np.broadcast_to(out.row.astype(complex), F.shape)[..., None])[..., 0]
     gain = (1j * w) ** q

@@ -196,11 +196,6 @@ def _embedded(function, i: int, P: int, n: int, omega: float) -> np.ndarray:
     return out
 
 
-def _impedances(system: LinearSystem, omega: np.ndarray) -> np.ndarray:
-    """``Z(Ω_k) = K − Ω_k²M + iΩ_kC`` (K, n, n) of thesis eq. (4.69) at the frequencies ``omega`` (K,)."""
-    return system.K[None] - omega[:, None, None] ** 2 * system.M[None] + 1j * omega[:, None, None] * system.C[None]
-
-
 def _partials(system: LinearSystem, omega: np.ndarray, cols: np.ndarray,
               slope: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """H (K,), ∂H/∂p (K, P) and ∂H/∂Ω (K,) of output ``cols[k]`` at frequency ``omega[k]``, all K at once.
@@ -215,7 +210,7 @@ def _partials(system: LinearSystem, omega: np.ndarray, cols: np.ndarray,
     outs = list(system.outputs.values())
     rows = np.array([outs[c].row for c in cols], dtype=complex).reshape(K, n)
     q = np.array([outs[c].order for c in cols], dtype=int)
-    Z = _impedances(system, omega)
+    Z = system.impedance(omega)
     F = system.forcing.values(omega).reshape(K, n)
     if not np.all(np.isfinite(F)):
         bad = omega[~np.all(np.isfinite(F), axis=1)]
@@ -257,7 +252,7 @@ def _partials_at(system: LinearSystem, omega: np.ndarray, cols: np.ndarray, slop
     try:
         return _limit_models(system, omega, cols, slope, models)
     except np.linalg.LinAlgError:  # a finite value at a singular Z: its limit from above
-        Z = _impedances(system, omega)
+        Z = system.impedance(omega)
         singular = np.linalg.slogdet(Z)[0] == 0  # the zero pivot that made the solve fail
         limit = ZeroZone(1e-7 * hi)
         models |= {int(k): (limit, float(omega[k])) for k in np.flatnonzero(singular) if k not in models}

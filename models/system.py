@@ -274,9 +274,13 @@ class LinearSystem:
         return self._pole_residue
 
     # ------------------------------------------------------------------ frequency response (4.69)
-    def impedance(self, omega: float) -> np.ndarray:
-        """``Z(Ω) = K − Ω²M + iΩC`` of thesis eq. (4.69)."""
-        return self.K - omega**2 * self.M + 1j * omega * self.C
+    def impedance(self, omega: float | np.ndarray) -> np.ndarray:
+        """``Z(Ω) = K − Ω²M + iΩC`` of thesis eq. (4.69): (n, n) at one Ω (rad/s), (N, n, n) stacked at the N
+        frequencies of a 1-D array."""
+        if np.ndim(omega) == 0:
+            return self.K - omega**2 * self.M + 1j * omega * self.C
+        w = np.asarray(omega, dtype=float)[:, None, None]
+        return self.K[None] - w**2 * self.M[None] + 1j * w * self.C[None]
 
     def forcing_at(self, omega: float) -> np.ndarray:
         """``F(Ω)``; a non-finite value is an error naming the forcing (never a silent inf)."""

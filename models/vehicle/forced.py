@@ -141,7 +141,7 @@ def _solve(system: LinearSystem, f: np.ndarray, names: list[str]) -> tuple[np.nd
     steady state exists (no root with Re s > 0)."""
     w = hz_to_rad_s(f)
     with np.errstate(over="ignore", invalid="ignore"):
-        Z = system.K[None] - w[:, None, None] ** 2 * system.M[None] + 1j * w[:, None, None] * system.C[None]
+        Z = system.impedance(w)
     if not np.all(np.isfinite(Z)):
         raise ValueError(f"frequencies_hz: Z(Ω) overflows at {f[~np.all(np.isfinite(Z), axis=(1, 2))][:3].tolist()} "
                          "Hz; no response can be computed there")
