@@ -82,7 +82,7 @@ def speed_pencil(system: LinearSystem) -> SpeedPencil | None:
         return None
     t = system.tangent
     n, S = system.n, float(t.speed)
-    C_speed = -(S * S) * np.asarray(t.dC_dspeed, dtype=float)
+    C_speed = t.creep_damping
     C0 = system.C - C_speed / S
     mk = np.linalg.solve(system.M, np.hstack([system.K, C0, C_speed]))
     A = np.zeros((2 * n, 2 * n))

@@ -66,11 +66,10 @@ def _damping_stack(member: LinearSystem, speeds: np.ndarray) -> np.ndarray:
     if t is None:
         raise ValueError("family: its members carry no parameter derivatives (Tangent); the stability rows need a "
                          "ParametricSystem (a vehicle view's family(), a study's stability family)")
-    if t.dC_dspeed is None:
+    C_speed = t.creep_damping  # the member is at S_0 = speeds[0]
+    if C_speed is None:
         return np.broadcast_to(member.C, (len(speeds), member.n, member.n))
-    S0 = float(speeds[0])
-    C_speed = -(S0 * S0) * np.asarray(t.dC_dspeed, dtype=float)
-    return member.C + (1.0 / speeds - 1.0 / S0)[:, None, None] * C_speed
+    return member.C + (1.0 / speeds - 1.0 / float(speeds[0]))[:, None, None] * C_speed
 
 
 def _family_rows(family: ParametricSystem, p: Sequence[float] | None, speeds: Sequence[float],

@@ -422,5 +422,14 @@ class Tangent:
     dC_dspeed: np.ndarray | None = None
     dF_dspeed: object = None
 
+    @property
+    def creep_damping(self) -> np.ndarray | None:
+        """C_speed (n, n) of the family's creep term C(S) = C₀ + C_speed/S, read back as −S²·∂C/∂S; None without
+        one (or without a speed)."""
+        if self.dC_dspeed is None or self.speed is None:
+            return None
+        S = float(self.speed)
+        return -(S * S) * np.asarray(self.dC_dspeed, dtype=float)
+
 
 __all__ = ["DEFAULT_OUTPUT", "LinearSystem", "Output", "RESPONSE_ORDER", "SINGULAR_PIVOT", "Tangent"]
