@@ -146,6 +146,18 @@ def residues(M: np.ndarray, V: np.ndarray, W: np.ndarray, rows: np.ndarray, A: n
 
 
 @njit(**JIT)
+def impedance(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: float, Z: np.ndarray) -> bool:
+    """Z (n, n) ← K − Ω²M + iΩC at Ω = ``w`` (thesis eq. 4.69); False when an entry is not finite."""
+    finite = True
+    for i in range(M.shape[0]):
+        for j in range(M.shape[0]):
+            Z[i, j] = complex(K[i, j] - w * w * M[i, j], w * C[i, j])
+            if not (math.isfinite(Z[i, j].real) and math.isfinite(Z[i, j].imag)):
+                finite = False
+    return finite
+
+
+@njit(**JIT)
 def direct_solutions(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: np.ndarray,
                      F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """X (N, n): Z(Ω)X = F(Ω) with Z = K − Ω²M + iΩC (thesis eqs. 4.69–4.70) at each Ω of ``w`` (N,), F (N, n)
@@ -155,18 +167,13 @@ def direct_solutions(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: np.ndarray,
     X = np.full((w.size, n), complex(math.nan, math.nan))
     overflow = np.zeros(w.size, np.bool_)
     Z = np.empty((n, n), np.complex128)
-    for solve in (False, True):  # first every Z is checked, then (none overflowing) solved
-        for t in range(w.size):
-            x = w[t]
-            for i in range(n):
-                for j in range(n):
-                    Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
-                    if not (math.isfinite(Z[i, j].real) and math.isfinite(Z[i, j].imag)):
-                        overflow[t] = True
-            if solve:
-                X[t] = np.linalg.solve(Z, np.ascontiguousarray(F[t]))
-        if overflow.any():
-            break
+    for t in range(w.size):  # first every Z is checked, then (none overflowing) solved
+        overflow[t] = not impedance(M, C, K, w[t], Z)
+    if overflow.any():
+        return X, overflow
+    for t in range(w.size):
+        impedance(M, C, K, w[t], Z)
+        X[t] = np.linalg.solve(Z, np.ascontiguousarray(F[t]))
     return X, overflow
 
 
@@ -740,30 +747,20 @@ def direct_outputs(M: np.ndarray, C: np.ndarray, K: np.ndarray, w: np.ndarray, A
     ``LinAlgError`` when a Z(Ω) is exactly singular.  THE direct-solve formula of the certified path."""
     n, m = M.shape[0], rows.shape[0]
     H = np.full((w.size, m), complex(math.inf, 0.0))
-    F = np.empty(n, np.complex128)
-    Z = np.empty((n, n), np.complex128)
+    F = np.empty((w.size, n), np.complex128)
     for t in range(w.size):
-        if not forcing_values(w[t], A, delays, F):
+        if not forcing_values(w[t], A, delays, F[t]):
             return H, 1
-        x = w[t]
-        for i in range(n):
-            for j in range(n):
-                Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
-                if not (math.isfinite(Z[i, j].real) and math.isfinite(Z[i, j].imag)):
-                    return H, 1
+    X, overflow = direct_solutions(M, C, K, w, F)
+    if overflow.any():
+        return H, 1
     for t in range(w.size):
-        x = w[t]
-        forcing_values(x, A, delays, F)
-        for i in range(n):
-            for j in range(n):
-                Z[i, j] = complex(K[i, j] - x * x * M[i, j], x * C[i, j])
-        X = np.linalg.solve(Z, F)
         for o in range(m):
             h = 0j
             for i in range(n):
-                h += rows[o, i] * X[i]
+                h += rows[o, i] * X[t, i]
             for _ in range(orders[o]):
-                h *= complex(0.0, x)
+                h *= complex(0.0, w[t])
             if math.isfinite(h.real) and math.isfinite(h.imag):
                 H[t, o] = h
     return H, 0
@@ -1024,7 +1021,7 @@ __all__ = [
     "band_grid", "brent_accept", "brent_points", "brent_propose", "brent_run", "brent_set_start", "brent_start",
     "cell_candidates", "cell_maxima_pole_residue", "cell_select", "certified_maxima", "certified_maxima_batch",
     "direct_magnitudes",
-    "direct_outputs", "direct_solutions", "forcing_values", "mode_order", "drop_falling_edges", "dual",
+    "direct_outputs", "direct_solutions", "forcing_values", "impedance", "mode_order", "drop_falling_edges", "dual",
     "edge_probes", "left_vectors", "log_or_value", "magnitudes", "member_state", "pole_residue_magnitudes",
     "pole_residue_sums", "refine_cells", "residues", "state_matrices", "take_better",
     "vertex_points", "vertex_run", "vertex_start", "vertex_update", "weak_roots",
