@@ -22,6 +22,7 @@ import distributed  # noqa: F401  (its config holds the connect timeout)
 import numpy as np
 import pytest
 from dask.utils import parse_timedelta
+from terminal import as_a_foreground_job
 
 from railopt.design import (
     CampaignStore,
@@ -391,7 +392,7 @@ def test_ctrl_c_to_the_process_group_prints_no_worker_traceback(tmp_path: Path) 
     script = tmp_path / "ctrl_c.py"
     script.write_text(CTRL_C)
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=as_a_foreground_job)
     pids = [int(p) for p in proc.stdout.readline().split()[1:]]
     assert len(pids) == 2
     assert proc.stdout.readline().strip() == "running"

@@ -37,6 +37,7 @@ from faults_cli import (
     study_file,
 )
 from reference_rule import assert_matches_reference
+from terminal import as_a_foreground_job
 
 from railopt.design import store as store_module
 from railopt.design.parallel import reporting_progress
@@ -330,7 +331,8 @@ def test_ctrl_c_while_the_local_cluster_starts_is_one_line(workers, tmp_path):
     before (each worker's KeyboardInterrupt, then dask's atexit); one line and exit 130 now."""
     study = study_file(tmp_path / "study", 3)
     proc = subprocess.Popen([*CLI, *run_args(study, tmp_path / "results", workers=workers)], env=env(),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=as_a_foreground_job)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None and not _spawned_workers(proc.pid):
         time.sleep(0.02)
