@@ -229,19 +229,27 @@ def label_clusters(table: pd.DataFrame, problem: MinimaxProblem, xtol: float = 1
     """
     table = table.copy()
     names = list(problem.space.names)
-    table["success"] = succeeded(table["status"].to_numpy(), table["constraint_violation"].to_numpy(),
-                                 table["bound_violation"].to_numpy(), table["value"].to_numpy(dtype=float))
-    table["cluster"] = -1
-    reps: list[np.ndarray] = []
-    for idx in table[table["success"]].sort_values(["value", "start_id"]).index:
-        u = problem.space.to_u(table.loc[idx, names].to_numpy(dtype=float))
-        for k, r in enumerate(reps):
-            if np.max(np.abs(u - r)) <= xtol:
-                table.loc[idx, "cluster"] = k
-                break
+    success = np.asarray(succeeded(table["status"].to_numpy(), table["constraint_violation"].to_numpy(),
+                                   table["bound_violation"].to_numpy(), table["value"].to_numpy(dtype=float)),
+                         dtype=bool)
+    table["success"] = success
+    # the successful starts from the best U (ties: the lower start id); each joins the first representative within
+    # xtol, else becomes the next one — on arrays (a per-row .loc cost ~1 ms a start: 10 s for 10,000 starts)
+    order = np.lexsort((table["start_id"].to_numpy(), table["value"].to_numpy(dtype=float)))
+    order = order[success[order]]
+    u = problem.space.to_u(table[names].to_numpy(dtype=float))
+    cluster = np.full(len(table), -1, dtype=int)
+    reps = np.empty((len(order), len(names)))
+    found = 0
+    for i in order:
+        near = np.flatnonzero(np.max(np.abs(reps[:found] - u[i]), axis=1) <= xtol)
+        if near.size:
+            cluster[i] = near[0]
         else:
-            reps.append(u)
-            table.loc[idx, "cluster"] = len(reps) - 1
+            reps[found] = u[i]
+            cluster[i] = found
+            found += 1
+    table["cluster"] = cluster
     return table
 
 

@@ -59,7 +59,7 @@ class SolveResult(ArrayRecord):
     evaluations : int
         Number of f evaluations (with or without gradient).
     wall_time : float
-        Seconds.
+        Seconds of the whole solve, its certification (:attr:`MinimaxProblem.refine`) and exchange rounds included.
     method : str
         Registered method name.
     x0 : (d,) ndarray

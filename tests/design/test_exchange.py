@@ -9,6 +9,7 @@ adds the worst t = atan2(x2, x1) while the violation exceeds its tolerance.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -35,14 +36,16 @@ def _gradient(x: np.ndarray) -> np.ndarray:
 U_STAR = (math.sqrt(20.0) - 1.0) ** 2
 
 
-def disk_problem(rows: tuple[float, ...], tolerance: float, calls: list | None = None) -> MinimaxProblem:
+def disk_problem(rows: tuple[float, ...], tolerance: float, calls: list | None = None,
+                 pause: float = 0.0) -> MinimaxProblem:
     t = np.asarray(rows)
 
     def refine(x: np.ndarray) -> MinimaxProblem | None:
         if calls is not None:
             calls.append(np.array(x))
+        time.sleep(pause)  # a certification that takes time (the flagship's certified critical speed: ~0.1 s)
         worst, where = _violation(x)
-        return None if worst <= tolerance else disk_problem((*rows, where), tolerance, calls)
+        return None if worst <= tolerance else disk_problem((*rows, where), tolerance, calls, pause)
 
     return MinimaxProblem(
         VARIABLES, _objective, jacobian=_gradient,
@@ -85,3 +88,15 @@ def test_a_design_certified_at_once_is_solved_once() -> None:
 def test_refine_must_be_callable() -> None:
     with pytest.raises(ValueError, match="refine"):
         MinimaxProblem(VARIABLES, lambda x: x, refine=3)
+
+
+@pytest.mark.parametrize("rows", [(0.0, math.pi / 2), (0.0, math.atan2(2.0, 1.0), math.pi / 2)],
+                         ids=["exchanged", "certified-at-once"])
+def test_a_start_s_wall_time_includes_its_certifications(rows) -> None:
+    """Each certification sleeps 0.05 s: the start's wall time counts every one (it once counted the solves only)."""
+    calls: list = []
+    began = time.perf_counter()
+    result = solve(disk_problem(rows, 1e-3, calls, pause=0.05), [0.5, 0.5], "slsqp", xtol=1e-10, ftol=1e-12)
+    elapsed = time.perf_counter() - began
+    assert result.success and len(calls) >= 1
+    assert 0.05 * len(calls) <= result.wall_time <= elapsed
