@@ -130,7 +130,9 @@ def multistart(
         by default a resume skips them, as it skips every finished start.
     batch : int, optional
         Starts per dask task; default: one start on each worker first, then :func:`batch_size` from the
-        median time of those (tasks of about 0.25 s, at least eight per worker, 1 to 8 starts).
+        median time of those (tasks of about 0.25 s, at least eight per worker, 1 to 8 starts) — or, when there
+        are too few starts for a batch of two at any start time, one start per task from the outset (no wait for
+        the first starts to finish).
         Each start is solved, stored and reported exactly as alone: batching changes no number.
 
     A start whose task kills every dask worker that runs it (a crash in native code, out of memory)
@@ -203,10 +205,12 @@ def multistart(
                 return [_StartBatch(shipped, tuple(starts[i:i + size]), method, user_options)
                         for i in range(0, len(starts), size)]
 
+            workers = 1 if client is None else _worker_threads(client)
             if client is None or batch is not None:
                 suspects = run(batches(todo, int(batch or 1)))
+            elif batch_size(len(todo) - workers, workers, 0.0) == 1:  # too few starts to batch, however short:
+                suspects = run(batches(todo, 1))  # one start per task, and no wait for a probe to finish
             else:  # one start per worker first: how long a start takes decides the batch
-                workers = _worker_threads(client)
                 probe, rest = todo[:workers], todo[workers:]
                 suspects = run(batches(probe, 1))
                 size = batch_size(len(rest), workers, float(np.median(seconds)) if seconds else 0.0)

@@ -91,6 +91,36 @@ def test_a_campaign_ships_its_problem_once_and_stores_the_serial_rows(client, tm
 
 
 @pytest.mark.timeout(180)
+@pytest.mark.parametrize("n_starts,maps", [(12, [[1] * 12]), (40, None)], ids=["too-few-to-batch", "probed"])
+def test_a_campaign_too_small_to_batch_is_one_map_without_a_probe(client, n_starts, maps) -> None:
+    """12 starts on 2 workers cannot make tasks of two starts while keeping 8 tasks per worker (batch_size's rule,
+    whatever a start costs): one map of one-start tasks, no wait for a probe map to finish first.  40 starts
+    can: a probe map of one start per worker, then the batches (at most 8 starts each)."""
+    from railopt.design.multistart import MAX_BATCH, batch_size
+
+    assert batch_size(n_starts - 2, 2, 0.0) == (1 if maps else 2)  # the rule, independently of the code path
+    seen: list[list[int]] = []
+    submit = client.map
+
+    def spy_map(fn, items, **kwargs):
+        items = list(items)
+        seen.append([len(item.starts) for item in items])
+        return submit(fn, items, **kwargs)
+
+    client.map = spy_map
+    try:
+        table = multistart(PROBLEM, n_starts, seed=6, client=client)
+    finally:
+        del client.map
+    if maps:
+        assert seen == maps
+    else:
+        assert seen[0] == [1, 1] and len(seen) == 2 and 1 <= max(seen[1]) <= MAX_BATCH
+        assert sum(map(sum, seen)) == n_starts
+    pd.testing.assert_frame_equal(table[DETERMINISTIC], multistart(PROBLEM, n_starts, seed=6)[DETERMINISTIC])
+
+
+@pytest.mark.timeout(180)
 def test_workers_started_afresh_get_the_shipped_problem(client) -> None:
     with shipping(client, PROBLEM) as handle:
         assert isinstance(handle, Shipped) and len(cloudpickle.dumps(handle)) < 200
