@@ -19,6 +19,12 @@ from railopt.records import ArrayRecord
 
 UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
 NEUTRAL_ROOT = 1e-8  # |s| ≤ NEUTRAL_ROOT · max|s| counts as s = 0 (a free rigid-body motion, not instability)
+# A free motion x = a + bt (a body free to drift, undamped: a Jordan block at s = 0) is split by rounding into a
+# pair ±δ or ±iδ with δ ≈ √ε·max|s| — measured 1.1e-8 to 1.3e-8·max|s| on one CPU, below 1e-8 on another — so
+# NEUTRAL_ROOT alone classifies it by the machine's rounding.  Within DEFECTIVE_ZERO·max|s| of 0, roots that sum
+# to 0 within UNDAMPED_ROOT·max|s| (rounding keeps the trace of the block; a slow damped mode −a ± iω sums to −2a)
+# are neutral too (neutral_roots).
+DEFECTIVE_ZERO = 1e-6
 CONDITION_LIMIT = 1e8  # cond₁(V) above which the pole–residue form is not used (errors ≳ 1e-8)
 
 
@@ -80,14 +86,36 @@ def mode_order(s: np.ndarray) -> np.ndarray:
     return np.lexsort((s.real, np.abs(s.imag)))
 
 
+def neutral_roots(s: np.ndarray) -> np.ndarray:
+    """Which roots are s = 0 up to rounding (free rigid-body motion), a bool mask of the shape of ``s`` (…, 2n);
+    each row of a stack (the last axis) is judged alone.
+
+    Neutral: |s| ≤ NEUTRAL_ROOT·max|s| (a simple zero), or a cluster of two or more roots within
+    DEFECTIVE_ZERO·max|s| of 0 that sums to 0 within UNDAMPED_ROOT·max|s| (a defective zero, split by rounding
+    to ±√ε·max|s|: see DEFECTIVE_ZERO).  A slow mode that is damped (−a ± iω, a beyond rounding) is not neutral.
+    An undamped saddle ±δ with δ ≤ 1e-6·max|s| cannot be told from a split Jordan block in double precision and
+    is taken as neutral.
+    """
+    s = np.asarray(s)
+    if s.size == 0:
+        return np.zeros(s.shape, dtype=bool)
+    size = np.abs(s)
+    scale = np.max(size, axis=-1, keepdims=True)
+    near = size <= DEFECTIVE_ZERO * scale
+    total = np.abs(np.sum(np.where(near, s, 0.0), axis=-1, keepdims=True))
+    defective = near & (np.sum(near, axis=-1, keepdims=True) >= 2) & (total <= UNDAMPED_ROOT * scale)
+    return (size <= NEUTRAL_ROOT * scale) | defective
+
+
 def growing_roots(s: np.ndarray) -> np.ndarray:
-    """The roots with Re s > 0 beyond round-off (Re s > UNDAMPED_ROOT·|s|), neutral roots s ≈ 0 excepted:
-    with any of them the system has no steady-state response (thesis (4.59); SPEC §2.4)."""
+    """The roots with Re s > 0 beyond round-off (Re s > UNDAMPED_ROOT·|s|), neutral roots s ≈ 0
+    (:func:`neutral_roots`) excepted: with any of them the system has no steady-state response (thesis (4.59);
+    SPEC §2.4)."""
     s = np.asarray(s)
     if s.size == 0:
         return s
-    scale = float(np.max(np.abs(s)))
-    return s[(s.real > UNDAMPED_ROOT * np.abs(s)) & (np.abs(s) > NEUTRAL_ROOT * scale)]
+    return s[(s.real > UNDAMPED_ROOT * np.abs(s)) & ~neutral_roots(s)]
 
 
-__all__ = ["CONDITION_LIMIT", "Modal", "NEUTRAL_ROOT", "UNDAMPED_ROOT", "growing_roots", "modal", "mode_order"]
+__all__ = ["CONDITION_LIMIT", "DEFECTIVE_ZERO", "Modal", "NEUTRAL_ROOT", "UNDAMPED_ROOT", "growing_roots", "modal",
+           "mode_order", "neutral_roots"]

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from railopt.models.modal import NEUTRAL_ROOT, mode_order
+from railopt.models.modal import mode_order, neutral_roots
 from railopt.models.system import LinearSystem
 from railopt.models.units import rad_s_to_hz
 
@@ -302,15 +302,15 @@ def named_modes(system: LinearSystem, groups: Mapping[str, str] | None = None,
     """Every mode of ``system`` named by its shape, one per mode in railopt's mode order (ascending |Im s|, then
     Re s: the roots ``mode_order(s)[1::2]``, a real pair counting as one mode).
 
-    Names by :func:`mode_name`; a neutral root (|s| ≤ NEUTRAL_ROOT·max|s|) is "rigid body"; distinct modes that
-    the shape names alike get " #2", " #3", ... after the first (in this order, so by ascending frequency).
-    ``groups`` body → group, ``main`` the car body (a vehicle view has both).  Returns a list of
-    :class:`NamedMode` (length n).
+    Names by :func:`mode_name`; a neutral root (:func:`~railopt.models.modal.neutral_roots`) is "rigid body";
+    distinct modes that the shape names alike get " #2", " #3", ... after the first (in this order, so by
+    ascending frequency).  ``groups`` body → group, ``main`` the car body (a vehicle view has both).  Returns a
+    list of :class:`NamedMode` (length n).
     """
     m = system.modal()
     n = system.n
     layout = _Layout(system.names, groups, main)
-    scale = float(np.max(np.abs(m.s))) if len(m.s) else 0.0
+    neutral = neutral_roots(m.s)
     out, seen = [], {}
     for k in mode_order(m.s)[1::2]:
         s = complex(m.s[k])
@@ -321,7 +321,7 @@ def named_modes(system: LinearSystem, groups: Mapping[str, str] | None = None,
         lead = int(np.argmax(shares))
         v = v / v[lead] if v[lead] != 0 else v
         kappa = circulation(system, v, s)
-        if abs(s) <= NEUTRAL_ROOT * scale:
+        if neutral[k]:
             name, group, share = "rigid body", layout.body[lead], float(shares[lead])
         else:
             name, group, share = _name(layout, system, v, shares, s, kappa)

@@ -30,7 +30,7 @@ import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
 from railopt.models.crossings import declares_creep
-from railopt.models.modal import NEUTRAL_ROOT, mode_order
+from railopt.models.modal import mode_order, neutral_roots
 from railopt.models.mode_names import (
     HUNTING_CIRCULATION,
     HUNTING_DAMPING,
@@ -325,7 +325,7 @@ def _critical_root(counted: _Counted, speed: float) -> tuple[float, str, str]:
     system = counted.at(speed)
     m = system.modal()
     n = system.n
-    real = np.where(np.abs(m.s) > NEUTRAL_ROOT * np.max(np.abs(m.s)), m.s.real, -np.inf)
+    real = np.where(neutral_roots(m.s), -np.inf, m.s.real)
     j = int(np.argmax(real))
     name = _named_roots(system, [j], counted.groups, counted.main)[0]["name"]
     return (float(rad_s_to_hz(abs(m.s[j].imag))), name, system.names[int(np.argmax(np.abs(m.V[:n, j])))])
@@ -374,7 +374,7 @@ def critical_speed_gradient(family: ParametricSystem, p: Sequence[float] | None 
         return cs, grad
     system = member.at(speed=cs.speed)
     s = system.modal().s
-    live = np.where(np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s)), s.real, -np.inf)
+    live = np.where(neutral_roots(s), -np.inf, s.real)
     k = int(np.argmax(live))
     d_speed = float(root_speed_derivative(system)[k].real)
     if d_speed == 0.0:

@@ -25,7 +25,7 @@ import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
 from railopt.models.crossings import crossing_speeds, speed_pencil
-from railopt.models.modal import NEUTRAL_ROOT
+from railopt.models.modal import neutral_roots
 from railopt.models.mode_names import _named_roots
 from railopt.models.protocols import SpeedFamily, StabilityModel
 from railopt.models.system import LinearSystem
@@ -49,9 +49,8 @@ def checked_speed_range(speed_range: object) -> tuple[float, float]:
 
 
 def abscissa(s: np.ndarray) -> float:
-    """max Re s over the roots that are not neutral rigid-body roots (|s| ≤ 1e-8 max|s| counts as s = 0)."""
-    scale = float(np.max(np.abs(s))) if s.size else 0.0
-    live = s[np.abs(s) > NEUTRAL_ROOT * scale]
+    """max Re s over the roots that are not neutral rigid-body roots (:func:`~railopt.models.modal.neutral_roots`)."""
+    live = s[~neutral_roots(s)]
     return float(np.max(live.real)) if live.size else 0.0
 
 
@@ -90,7 +89,7 @@ class CountedFamily:
     def least_damping(self, speed: float) -> float:
         """The least damping ratio −Re s/|s| of the non-neutral roots at ``speed`` (one eigen-solve; inf if none)."""
         s = self.roots(float(speed))
-        live = s[np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s))]
+        live = s[~neutral_roots(s)]
         return float(np.min(-live.real / np.abs(live))) if live.size else math.inf
 
     def margin(self, speed: float, sigma: float) -> float:
@@ -102,7 +101,7 @@ class CountedFamily:
         self.solves += 1
         system = self.at(speed)
         s = system.modal().s
-        live = np.abs(s) > NEUTRAL_ROOT * np.max(np.abs(s))
+        live = ~neutral_roots(s)
         if not live.any():
             return ""
         j = int(np.argmin(np.where(live, np.abs(s.real + sigma), np.inf)))

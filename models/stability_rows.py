@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from railopt.models.modal import NEUTRAL_ROOT, mode_order
+from railopt.models.modal import mode_order, neutral_roots
 from railopt.models.mode_names import _body_dof, _shares, _track_body, named_modes
 from railopt.models.sensitivity import (
     damping_ratio_jacobian,
@@ -94,12 +94,10 @@ def _family_rows(family: ParametricSystem, p: Sequence[float] | None, speeds: Se
     G[:, n:, :] = -AB
     s, V = np.linalg.eig(G)  # numpy loops over the stack in C
     idx = mode_order(s)[:, 1::2]  # mode_order sorts each row of a stack alone
-    roots = np.take_along_axis(s, idx, axis=1)
     shapes = np.take_along_axis(V[:, :n, :], idx[:, None, :], axis=2)  # (K, n, n): coordinates × modes
     shares = _shares(member, shapes.transpose(1, 0, 2).reshape(n, K * n)).reshape(n, K, n)  # M shared by all
     track = np.array([_track_body(_body_dof(c)[0]) for c in member.names], dtype=bool)
-    scale = np.max(np.abs(s), axis=1, keepdims=True)
-    keep = (np.abs(roots) > NEUTRAL_ROOT * scale) & (shares[track].sum(axis=0) <= 0.5)
+    keep = ~np.take_along_axis(neutral_roots(s), idx, axis=1) & (shares[track].sum(axis=0) <= 0.5)
     groups, main = getattr(family, "groups", None), getattr(family, "main_body", None)
     for k in range(K) if exclude else ():
         named = named_modes(LinearSystem(member.M, C[k], member.K, names=member.names), groups, main)

@@ -7,6 +7,7 @@ import pickle
 
 import cloudpickle
 import numpy as np
+import pytest
 
 from railopt.models.modal import CONDITION_LIMIT, Modal, modal
 from railopt.models.system import LinearSystem
@@ -22,7 +23,9 @@ def test_left_eigenvectors_when_first_read_and_then_the_same() -> None:
     np.testing.assert_allclose(W @ m.V, np.eye(6), atol=1e-12)  # W = V⁻¹
     np.testing.assert_allclose(W @ G, m.s[:, None] * W, atol=1e-11)  # rows are left eigenvectors
     assert m.W is W and not W.flags.writeable
-    assert m.condition == np.linalg.norm(m.V, 1) * np.linalg.norm(W, 1)
+    # the kernel's sums of |v_ij| against numpy's norm: the same definition, rounded in another order (numpy's
+    # complex abs and pairwise sums depend on the CPU's vector instructions), so equal to a few ulps, not bits
+    assert m.condition == pytest.approx(np.linalg.norm(m.V, 1) * np.linalg.norm(W, 1), rel=1e-14, abs=0.0)
     for dumps, loads in ((pickle.dumps, pickle.loads), (cloudpickle.dumps, cloudpickle.loads)):
         before = loads(dumps(modal(G)))  # pickled before W was read
         after = loads(dumps(m))
@@ -39,3 +42,48 @@ def test_a_singular_eigenvector_matrix_gives_nan_w_and_infinite_condition() -> N
     jordan = LinearSystem(np.eye(1), np.array([[2.0]]), np.array([[1.0]]), F=np.ones(1))  # s = −1 twice
     assert jordan.modal().condition > CONDITION_LIMIT
     assert jordan.pole_residue() is None
+
+
+def test_neutral_roots_take_a_split_jordan_block_at_zero_and_not_a_slow_damped_mode() -> None:
+    """A free undamped drift x = a + bt is a Jordan block at s = 0; rounding splits it into ±δ or ±iδ with
+    δ ≈ √ε·max|s| (1.1e-8 to 1.3e-8 measured on one CPU: above NEUTRAL_ROOT = 1e-8, so |s| alone misjudged it
+    there).  The pair sums to 0 within rounding; a slow damped mode −a ± iω does not."""
+    from railopt.models.modal import DEFECTIVE_ZERO, NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots, neutral_roots
+
+    fast = np.array([-3.0 - 40.0j, -3.0 + 40.0j, -10.0 - 5.0j, -10.0 + 5.0j])
+    scale = np.max(np.abs(fast))
+    for split in (1j * 1.3e-8 * scale + 3e-15, 1.3e-8 * scale, 5e-7 * scale):  # ±iδ, ±δ (a real pair), 5e-7
+        s = np.concatenate([fast, [split, -split]])
+        assert abs(split) > NEUTRAL_ROOT * scale and abs(split) <= DEFECTIVE_ZERO * scale
+        np.testing.assert_array_equal(neutral_roots(s), [False] * 4 + [True] * 2)
+        assert growing_roots(s).size == 0  # +δ of a split block is not an instability
+    slow = 1.3e-8 * scale * np.exp(1j * np.array([0.6, -0.6]) + 1j * np.pi / 2)  # ζ = sin 0.6: damped
+    slow = -np.abs(slow.real) + 1j * slow.imag
+    assert abs(slow.sum()) > UNDAMPED_ROOT * scale
+    assert not neutral_roots(np.concatenate([fast, slow])).any()
+    lone = np.concatenate([fast, [2e-7 * scale]])  # one slow real root alone: a genuine slow divergence
+    assert not neutral_roots(lone).any() and growing_roots(lone).size == 1
+    simple = np.concatenate([fast, [1e-9 * scale]])
+    np.testing.assert_array_equal(neutral_roots(simple), [False] * 4 + [True])
+    stack = np.stack([np.concatenate([fast, [1.3e-8 * scale, -1.3e-8 * scale]]),
+                      np.concatenate([fast, slow])])
+    np.testing.assert_array_equal(neutral_roots(stack), [[False] * 4 + [True] * 2, [False] * 6])  # rows alone
+
+
+def test_a_free_undamped_body_is_neutral_whatever_the_rounding() -> None:
+    """Two bodies joined by a spring and a damper, free to drift together: roots 0 (double, defective: the drift
+    x = a + bt) and the relative mode.  Whatever the computed split of the double zero, exactly those two roots
+    are neutral, at every scaling of the stiffness (the split is ~√ε·max|s|)."""
+    from railopt.models.modal import neutral_roots
+
+    for k in (1e2, 1e4, 1e6, 1e8):
+        K = k * np.array([[1.0, -1.0], [-1.0, 1.0]])
+        C = 0.02 * np.sqrt(k) * np.array([[1.0, -1.0], [-1.0, 1.0]])
+        system = LinearSystem(np.diag([2.0, 3.0]), C, K, F=np.ones(2))
+        s = system.eigenvalues()
+        mask = neutral_roots(s)
+        assert mask.sum() == 2, (k, s)
+        # the relative mode's roots, closed form: m_r s² + c s + k = 0 with m_r = 2·3/5
+        m_r, c = 6.0 / 5.0, 0.02 * np.sqrt(k)
+        expected = np.roots([m_r, c, k])
+        np.testing.assert_allclose(np.sort_complex(s[~mask]), np.sort_complex(expected), rtol=1e-9)
