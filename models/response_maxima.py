@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from railopt.models import kernels
-from railopt.models.modal import CONDITION_LIMIT, NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots
+from railopt.models.modal import CONDITION_LIMIT, NEUTRAL_ROOT, UNDAMPED_ROOT, growing_roots, neutral_roots
 from railopt.models.peak_search import BRACKET_RTOL, cell_maxima
 from railopt.models.pole_residue import forcing_arrays
 from railopt.models.units import rad_s_to_hz
@@ -246,8 +246,7 @@ def _maxima(system: LinearSystem, lo: float, hi: float, exact: bool, names: list
     clipped_eval = np.clip(wd, lo_eval, hi)
     # an undamped mode inside the band has an unbounded peak, whatever rounding makes of Z(ω_d); the neutral roots
     # of free rigid-body motion (s ≈ 0, perhaps ±iδ by rounding) are not modes with a peak
-    scale = float(np.max(np.abs(roots), initial=0.0))
-    neutral_modes = np.abs(modes) <= NEUTRAL_ROOT * scale
+    neutral_modes = neutral_roots(roots)[1::2]
     undamped = (np.abs(modes.real) <= UNDAMPED_ROOT * np.abs(modes)) & (modes.imag != 0) & ~neutral_modes
     resonant = undamped & (wd >= lo) & (wd <= hi)
     if not exact:
@@ -264,9 +263,10 @@ def _maxima(system: LinearSystem, lo: float, hi: float, exact: bool, names: list
 
     modal = system.modal()
     poles = modal.s
-    poles = poles[np.abs(poles.real) > UNDAMPED_ROOT * np.abs(poles)]  # their cells are inf anyway
+    damped = np.abs(poles.real) > UNDAMPED_ROOT * np.abs(poles)  # the undamped poles' cells are inf anyway
     if zone is not None:  # the outputs have a finite limit at 0: the neutral poles are cancelled there
-        poles = poles[np.abs(poles) > NEUTRAL_ROOT * scale]
+        damped &= ~neutral_roots(poles)
+    poles = poles[damped]
     # cell boundaries from the band's clipping (not the zone's step, which moves with the design): the same cells
     # whatever the limit model, so a maximum on a boundary moves with the damped frequencies only
     bounds = np.concatenate([[lo_eval], np.maximum(0.5 * (clipped[1:] + clipped[:-1]), lo_eval), [hi]]).astype(float)
@@ -345,13 +345,14 @@ class _NearZero:
 def zero_zone(system: LinearSystem, hi: float, roots: np.ndarray | None = None) -> ZeroZone | None:
     """The zone near Ω = 0 where free rigid-body roots make ``Z(Ω)`` singular to rounding, or None without them.
 
-    Roots with |s| ≤ NEUTRAL_ROOT·max|s| are free rigid-body motion (s = 0 perturbed by rounding, perhaps to ±iδ).
+    Neutral roots (:func:`~railopt.models.modal.neutral_roots`) are free rigid-body motion (s = 0 perturbed by
+    rounding, perhaps to ±iδ).
     The zone's step is ε = 1.2e-4·(least non-neutral |s|), at most 1e-3·``hi`` (rad/s); below ε the rounding of a
     direct solve grows as 1/Ω² (the response there is :class:`ZeroZone`'s limit model).
     """
     s = system.eigenvalues() if roots is None else roots
     scale = float(np.max(np.abs(s))) if s.size else 0.0
-    neutral = np.abs(s) <= NEUTRAL_ROOT * scale
+    neutral = neutral_roots(s)
     if scale == 0.0 or not np.any(neutral) or np.all(neutral):
         return None
     return ZeroZone(min(ZERO_STEP * float(np.min(np.abs(s[~neutral]))), 1e-3 * hi))
