@@ -22,7 +22,6 @@ import distributed  # noqa: F401  (its config holds the connect timeout)
 import numpy as np
 import pytest
 from dask.utils import parse_timedelta
-from terminal import as_a_foreground_job
 
 from railopt.design import (
     CampaignStore,
@@ -389,6 +388,7 @@ if __name__ == "__main__":
 @pytest.mark.timeout(120)
 def test_ctrl_c_to_the_process_group_prints_no_worker_traceback(tmp_path: Path) -> None:
     """SIGINT to the whole group (what Ctrl-C in a terminal does): the workers ignore it, dask says nothing."""
+    from terminal import as_a_foreground_job  # here: a dask worker that imports this module has no tests/
     script = tmp_path / "ctrl_c.py"
     script.write_text(CTRL_C)
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,

@@ -37,7 +37,6 @@ from faults_cli import (
     study_file,
 )
 from reference_rule import assert_matches_reference
-from terminal import as_a_foreground_job
 
 from railopt.design import store as store_module
 from railopt.design.parallel import reporting_progress
@@ -329,6 +328,7 @@ def _spawned_workers(pid: int) -> list[psutil.Process]:
 def test_ctrl_c_while_the_local_cluster_starts_is_one_line(workers, tmp_path):
     """SIGINT to the process group (Ctrl-C) while the worker processes are still importing: 30–124 traceback lines
     before (each worker's KeyboardInterrupt, then dask's atexit); one line and exit 130 now."""
+    from terminal import as_a_foreground_job  # here: a dask worker that imports this module has no tests/
     study = study_file(tmp_path / "study", 3)
     proc = subprocess.Popen([*CLI, *run_args(study, tmp_path / "results", workers=workers)], env=env(),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
