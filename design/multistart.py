@@ -205,7 +205,7 @@ def multistart(
                 return [_StartBatch(shipped, tuple(starts[i:i + size]), method, user_options)
                         for i in range(0, len(starts), size)]
 
-            workers = 1 if client is None else _worker_threads(client)
+            workers = 1 if client is None or batch is not None else _worker_threads(client)
             if client is None or batch is not None:
                 suspects = run(batches(todo, int(batch or 1)))
             elif batch_size(len(todo) - workers, workers, 0.0) == 1:  # too few starts to batch, however short:

@@ -26,7 +26,7 @@ from functools import partial
 import numpy as np
 
 from railopt.models.forcing import DelayedTerm, Forcing
-from railopt.models.modal import NEUTRAL_ROOT, mode_order
+from railopt.models.modal import mode_order, neutral_roots
 from railopt.models.response_maxima import ResponseMaxima, ZeroZone, all_response_maxima, zero_zone
 from railopt.models.system import LinearSystem, Tangent
 from railopt.models.validation import band_arg
@@ -309,7 +309,7 @@ def maxima_jacobians(system: LinearSystem, band: object = None, *, band_hz: tupl
         return {}
     wd = system.damped_frequencies()
     zone = zero_zone(system, hi)
-    neutral = np.abs(system.mode_roots()) <= NEUTRAL_ROOT * float(np.max(np.abs(system.eigenvalues()), initial=0.0))
+    neutral = neutral_roots(system.eigenvalues())[1::2]  # one per mode, as mode_roots() = eigenvalues()[1::2]
     inside = (wd > lo) & (wd < hi) & ~neutral  # rigid-body roots (s ≈ 0) do not move a maximum's frequency
     dclip = None  # dω_dj/dp of the modes inside the band, computed when a maximum's frequency moves with one
 
