@@ -347,8 +347,8 @@ def zero_zone(system: LinearSystem, hi: float, roots: np.ndarray | None = None) 
 
     Neutral roots (:func:`~railopt.models.modal.neutral_roots`) are free rigid-body motion (s = 0 perturbed by
     rounding, perhaps to ±iδ).
-    The zone's step is ε = 1.2e-4·(least non-neutral |s|), at most 1e-3·``hi`` (rad/s); below ε the rounding of a
-    direct solve grows as 1/Ω² (the response there is :class:`ZeroZone`'s limit model).
+    The zone's step is ε = ZERO_STEP·(least non-neutral |s|) (ZERO_STEP = 1e-3), at most 1e-3·``hi`` (rad/s);
+    below ε the rounding of a direct solve grows as 1/Ω² (the response there is :class:`ZeroZone`'s limit model).
     """
     s = system.eigenvalues() if roots is None else roots
     scale = float(np.max(np.abs(s))) if s.size else 0.0
