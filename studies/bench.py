@@ -418,10 +418,10 @@ def _dispatch_rows(quick: bool, ceiling: float, workers: int) -> list[dict]:
                 f"serial {serial:.0f} starts/s; ")]
 
 
-def _tmd_throughput(problem: MinimaxProblem, workers: int, sizes: tuple[int, ...]) -> list[dict]:
-    """Starts per second of the exact TMD campaign, serial against a LocalCluster, at each campaign size: a short
-    campaign (dask's fixed cost per campaign and per task weighs on ~0.8 s of work) and a long one (the
-    throughput a campaign of many starts gets)."""
+def _throughput(problem: MinimaxProblem, objective: str, workers: int, sizes: tuple[int, ...]) -> list[dict]:
+    """Starts per second of ``problem``'s multistart, serial against a LocalCluster of ``workers``, at each campaign
+    size: for the TMD a short campaign (dask's fixed cost per campaign and per task weighs on ~0.8 s of work) and a
+    long one (the throughput a campaign of many starts gets); ``objective`` names the problem in the rows."""
     serial = {}
     for n in sizes:
         t = time.perf_counter()
@@ -434,7 +434,7 @@ def _tmd_throughput(problem: MinimaxProblem, workers: int, sizes: tuple[int, ...
             t = time.perf_counter()
             multistart(problem, n, seed=1, client=client)
             t_dask = time.perf_counter() - t
-            rows.append({"benchmark": f"multistart throughput, {n:,} starts (exact TMD objective)",
+            rows.append({"benchmark": f"multistart throughput, {n:,} starts ({objective})",
                          "ours_s": t_dask / n, "reference_s": serial[n] / n,
                          "reference": f"serial; ours = dask LocalCluster, {workers} workers",
                          "ratio": t_dask / serial[n],
@@ -447,19 +447,7 @@ def _cab_throughput(workers: int, quick: bool) -> dict:
     """Starts per second of the flagship's exact cab problem, serial against a LocalCluster."""
     _, config, _ = load_study(STUDIES / "cab_lateral_minimax.toml")
     problem = campaign_problem(config, config.setups()["sd40-2"], "exact")
-    n_starts = 8 if quick else 32
-    t = time.perf_counter()
-    multistart(problem, n_starts, seed=1)
-    t_serial = time.perf_counter() - t
-    with dask_client(workers=workers) as client:
-        multistart(problem, 2 * workers, seed=99, client=client)
-        t = time.perf_counter()
-        multistart(problem, n_starts, seed=1, client=client)
-        t_dask = time.perf_counter() - t
-    return {"benchmark": f"multistart throughput, {n_starts} starts (exact cab objective, the flagship)",
-            "ours_s": t_dask / n_starts, "reference_s": t_serial / n_starts,
-            "reference": f"serial; ours = dask LocalCluster, {workers} workers", "ratio": t_dask / t_serial,
-            "note": f"{n_starts / t_serial:.1f} starts/s serial, {n_starts / t_dask:.1f} starts/s dask"}
+    return _throughput(problem, "exact cab objective, the flagship", workers, (8 if quick else 32,))[0]
 
 
 def _finite_difference_twin(problem: MinimaxProblem, constrained: bool) -> MinimaxProblem:
@@ -647,7 +635,7 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
     ceiling_row = _ceiling_row(workers, n_starts)
     ceiling = 1.0 / ceiling_row["ratio"]
     problem = campaign_problem(config, setup, "exact")
-    parallel = [*_tmd_throughput(problem, workers, (n_starts, 16 * n_starts)),
+    parallel = [*_throughput(problem, "exact TMD objective", workers, (n_starts, 16 * n_starts)),
                 _cab_throughput(workers, quick), *_dispatch_rows(quick, ceiling, workers)]
     rows.append(ceiling_row)
     rows += [busy_marked(row, ceiling, workers) for row in parallel]
