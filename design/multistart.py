@@ -205,11 +205,10 @@ def multistart(
                 return [_StartBatch(shipped, tuple(starts[i:i + size]), method, user_options)
                         for i in range(0, len(starts), size)]
 
-            workers = 1 if client is None or batch is not None else _worker_threads(client)
             if client is None or batch is not None:
                 suspects = run(batches(todo, int(batch or 1)))
-            elif batch_size(len(todo) - workers, workers, 0.0) == 1:  # too few starts to batch, however short:
-                suspects = run(batches(todo, 1))  # one start per task, and no wait for a probe to finish
+            elif batch_size(len(todo) - (workers := _worker_threads(client)), workers, 0.0) == 1:
+                suspects = run(batches(todo, 1))  # too few starts to batch, however short: no probe to wait for
             else:  # one start per worker first: how long a start takes decides the batch
                 probe, rest = todo[:workers], todo[workers:]
                 suspects = run(batches(probe, 1))
