@@ -328,6 +328,17 @@ def reporting_progress(progress: ProgressCallback | None) -> Iterator[None]:
         _PROGRESS.reset(token)
 
 
+def progress_of(progress: ProgressCallback | None) -> ProgressCallback | None:
+    """The callback a map given ``progress`` reports to: ``progress`` itself, else the enclosing
+    :func:`reporting_progress` block's (None outside one) — for a caller that counts its own units (rows of a
+    surface computed in blocks) and passes :func:`no_progress` to the map."""
+    return progress if progress is not None else _PROGRESS.get()
+
+
+def no_progress(done: int, total: int) -> None:
+    """A progress callback that reports nothing (a map whose caller reports in its own units)."""
+
+
 # ---------------------------------------------------------------------- shipping once
 @dataclass(frozen=True)
 class Shipped:
@@ -498,7 +509,7 @@ def map_unordered_groups(
     if isinstance(most, bool) or not isinstance(most, numbers.Integral) or most < 1:
         raise ValueError(f"most: must be a whole number of results >= 1, got {most!r}")
     items = list(items)
-    report = progress if progress is not None else _PROGRESS.get()
+    report = progress_of(progress)
     groups = _map(fn, items, client, retries, on_lost, int(most))
     if report is None:
         yield from groups
@@ -884,5 +895,6 @@ __all__ = [
     "DASK_LOGS_ENV", "DEFAULT_SCHEDULER_TIMEOUT", "LOCAL_NO_WORKERS_LIMIT", "SCHEDULER_ENV", "SCHEDULER_MARGIN",
     "SCHEDULER_TIMEOUT_ENV", "ClusterRecord", "ProgressCallback", "SchedulerError", "WorkerLost", "call",
     "Shipped", "check_picklable", "cluster_record", "cluster_summary", "dask_client", "map_unordered",
-    "map_unordered_groups", "reporting_progress", "resolve", "scheduler_timeout", "shipping",
+    "map_unordered_groups", "no_progress", "progress_of", "reporting_progress", "resolve", "scheduler_timeout",
+    "shipping",
 ]

@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 
 from railopt.design import DesignVariable, MinimaxProblem
+from railopt.design import surface as surface_module
 from railopt.design.surface import objective_surface
 from railopt.design.tradeoff import epsilon_sweep, nondominated
 
@@ -52,7 +53,9 @@ def test_surface_values_and_bounds_mask():
         objective_surface(problem, ("a", "z"), xi, xj, base=[0.5, 0.5, 0.1])
 
 
-def test_a_batched_surface_calls_the_batch_once_per_row_and_equals_the_closed_form():
+def test_a_batched_surface_calls_the_batch_once_per_block_of_rows_and_equals_the_closed_form(monkeypatch):
+    """A batched surface is one ``batch_functions`` call per block of whole rows of at most BLOCK_POINTS points
+    (one call for a small grid), in any case the closed form, with the refused designs +inf."""
     v = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0), DesignVariable("c", 0.0, 1.0)]
     calls = []
 
@@ -74,7 +77,16 @@ def test_a_batched_surface_calls_the_batch_once_per_row_and_equals_the_closed_fo
     expected = np.where(A < 0, np.inf, np.maximum(A + 2 * B + 0.1, -A))
     np.testing.assert_array_equal(batched.values, expected)
     np.testing.assert_array_equal(plain.values, expected)
-    assert calls == [len(xi)] * len(xj)
+    assert calls == [len(xi) * len(xj)]  # 35 points: one block
+    calls.clear()
+    monkeypatch.setattr(surface_module, "BLOCK_POINTS", 2 * len(xi) + 3)  # two whole rows a block
+    again = objective_surface(MinimaxProblem(v, point, batch_functions=batch), ("a", "b"), xi, xj, [0.5, 0.5, 0.1])
+    np.testing.assert_array_equal(again.values, expected)
+    assert calls == [2 * len(xi), 2 * len(xi), len(xi)]
+    rows = []
+    objective_surface(MinimaxProblem(v, point, batch_functions=batch), ("a", "b"), xi, xj, [0.5, 0.5, 0.1],
+                      progress=lambda done, total: rows.append((done, total)))
+    assert rows == [(0, 5), (2, 5), (4, 5), (5, 5)]  # progress in rows, whatever the blocks
 
 
 def test_batch_values_refuse_malformed_shapes_and_nan():

@@ -1,5 +1,5 @@
 """The flagship's objective surface (studies/cab_lateral_minimax.toml's [[surfaces]]: U over (K2, K3), 21 × 21,
-on the bounds and relaxed toward zero stiffness) evaluated in batches (one compiled call per grid row) equals the
+on the bounds and relaxed toward zero stiffness) evaluated in batches (one compiled call for the grid) equals the
 same surface evaluated point by point through the problem's own objective, to 1e-12 relative."""
 
 from __future__ import annotations
