@@ -311,7 +311,8 @@ def check_picklable(obj: Any, name: str = "") -> None:
 
 # ---------------------------------------------------------------------- progress
 ProgressCallback = Callable[[int, int], None]
-"""``progress(done, total)``: called with ``done = 0`` when a map begins, then after every finished task."""
+"""``progress(done, total)``: called with ``done = 0`` when a map begins, then after every finished task (a grid
+map of :mod:`railopt.design.surface` counts rows: a task of several rows adds them all)."""
 
 _PROGRESS: ContextVar[ProgressCallback | None] = ContextVar("railopt_design_progress", default=None)
 

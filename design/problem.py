@@ -272,6 +272,8 @@ class MinimaxProblem:
                     continue
                 rows.append(self._as_vector(v[0] if self._jacobian is True else v, "functions"))  # ... NaN is not
             m = self._learn_function_count({len(r) for r in rows if r is not None}, "functions")
+            if m == 0:  # every design refused before any evaluation told the count: U = +inf at each
+                return np.full(len(X), np.inf)
             F = np.array([np.full(m, np.inf) if r is None else r for r in rows]).reshape(len(X), m)
         else:
             F = np.asarray(self._batch_functions(X), dtype=float)

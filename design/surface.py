@@ -58,8 +58,8 @@ against ~35 µs a point of the flagship's cab model: a 21-point row per call spe
 
 @dataclass(frozen=True)
 class _Rows:
-    """Rows of a grid (a task): ``fn`` at x with ``x[i]`` over ``xi`` and ``x[j]`` each of ``xj_values`` in turn,
-    the rest ``base``; returns ``[(xj_value, row values), ...]``."""
+    """Rows ``first``, ``first + 1``, … of a grid (a task): ``fn`` at x with ``x[i]`` over ``xi`` and ``x[j]`` each
+    of ``xj_values`` in turn, the rest ``base``; returns ``(first, values (rows, len(xi), …))``."""
 
     fn: Callable[[np.ndarray], object]
     base: np.ndarray
@@ -67,30 +67,36 @@ class _Rows:
     j: int
     xi: np.ndarray
     xj_values: tuple[float, ...]
+    first: int = 0
 
     batched: bool = False  # fn takes all the task's designs (rows × len(xi), d) at once
 
-    def __call__(self) -> list[tuple[float, np.ndarray]]:
+    def __call__(self) -> tuple[int, np.ndarray]:
         fn = resolve(self.fn)  # fn shipped once per grid (a handle inside a dask task)
         X = np.repeat(self.base[None, :], len(self.xi) * len(self.xj_values), axis=0)
         X[:, self.i] = np.tile(self.xi, len(self.xj_values))
         X[:, self.j] = np.repeat(self.xj_values, len(self.xi))
         if self.batched:
             values = np.asarray(fn(X), dtype=float)
+            if values.ndim == 0 or values.shape[0] != len(X):
+                raise ValueError(f"fn: a batched fn must return one value (or vector) per design, shape ({len(X)}, "
+                                 f"…), got shape {values.shape}")
         else:
             values = np.array([fn(x) for x in X], dtype=float)
-        values = values.reshape(len(self.xj_values), len(self.xi), *values.shape[1:])
-        return list(zip(self.xj_values, values, strict=True))
+        return self.first, values.reshape(len(self.xj_values), len(self.xi), *values.shape[1:])
 
 
 @dataclass(frozen=True)
 class _Values:
-    """U at a row of designs (B, d); +inf where the model refuses a design (e.g. a singular model at zero
-    stiffness): :meth:`MinimaxProblem.values`, batched when the problem has ``batch_functions``."""
+    """U at a block of designs (B, d) or at one design; +inf where the model refuses a design (e.g. a singular
+    model at zero stiffness): :meth:`MinimaxProblem.values`, batched when the problem has ``batch_functions``."""
 
     problem: MinimaxProblem
 
-    def __call__(self, X: np.ndarray) -> np.ndarray:
+    def __call__(self, X: np.ndarray) -> np.ndarray | float:
+        """U at the designs X (B, d), or at one design x (d,) (a grid evaluated a design at a time)."""
+        if X.ndim == 1:
+            return float(self.problem.values(X[None, :])[0])
         return self.problem.values(X)
 
 
@@ -116,21 +122,23 @@ def grid_map(fn: Callable[[np.ndarray], object], space_names: Sequence[str], nam
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
     if client is not None:
         check_picklable(fn)  # named from fn's own fields (e.g. problem.functions), not the row task's
-    per_task = max(1, BLOCK_POINTS // max(len(xi), 1)) if batched else 1
-    blocks = [tuple(float(v) for v in xj[k:k + per_task]) for k in range(0, len(xj), per_task)]
+    if len(xi) == 0 or len(xj) == 0:
+        return np.zeros((len(xj), len(xi)))
+    per_task = max(1, BLOCK_POINTS // len(xi)) if batched else 1
+    tasks = [(k, tuple(float(v) for v in xj[k:k + per_task])) for k in range(0, len(xj), per_task)]
     report = progress_of(progress)  # counted in rows, whatever the tasks
-    if report is not None:
-        report(0, len(xj))
-    rows: dict[float, np.ndarray] = {}
+    blocks: dict[int, np.ndarray] = {}  # by position (equal, -0.0 or NaN values of xj stay apart)
     finished = 0
     with shipping(client, fn, "fn") as shipped:  # the problem goes to the workers once, not with every task
-        for done in map_unordered(call, [_Rows(shipped, base, i, j, xi, b, batched) for b in blocks],
-                                  client=client, progress=no_progress):
-            rows.update(done)
-            finished += len(done)
+        if report is not None:
+            report(0, len(xj))
+        for first, values in map_unordered(call, [_Rows(shipped, base, i, j, xi, b, k, batched) for k, b in tasks],
+                                           client=client, progress=no_progress):
+            blocks[first] = values
+            finished += len(values)
             if report is not None:
                 report(finished, len(xj))
-    return np.array([rows[float(v)] for v in xj])
+    return np.concatenate([blocks[k] for k, _ in tasks])
 
 
 def objective_surface(
@@ -142,11 +150,13 @@ def objective_surface(
     client: Runner | None = None,
     progress: ProgressCallback | None = None,
 ) -> Surface:
-    """U over ``xi × xj`` for the two named variables, the others at ``base``: one task per block of whole rows of
-    about :data:`BLOCK_POINTS` points (``progress(done, total)`` in rows, as :func:`grid_map`), each block one call
-    of the problem's ``batch_functions`` when it has them (:meth:`MinimaxProblem.values`)."""
+    """U over ``xi × xj`` for the two named variables, the others at ``base`` (``progress(done, total)`` in rows, as
+    :func:`grid_map`).  A problem with ``batch_functions`` (:meth:`MinimaxProblem.values`) goes in blocks of whole
+    rows of about :data:`BLOCK_POINTS` points, one task and one call each; any other one task per grid row, a design
+    at a time (so that a cluster shares the rows)."""
     space = problem.space
-    values = grid_map(_Values(problem), space.names, names, xi, xj, base, client, progress, batched=True)
+    values = grid_map(_Values(problem), space.names, names, xi, xj, base, client, progress,
+                      batched=problem.has_batch)
     i, j = space.names.index(names[0]), space.names.index(names[1])
     xi, xj = np.asarray(xi, dtype=float), np.asarray(xj, dtype=float)
     inside_i = (xi >= space.lower[i]) & (xi <= space.upper[i])

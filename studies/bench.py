@@ -520,7 +520,7 @@ def _cab_rows(repeat: int) -> list[dict]:
 def surface_row(points: int | None = None, repeat: int = 5) -> dict:
     """The flagship's objective surface ([[surfaces]] of cab_lateral_minimax.toml: U over its two variables, the
     others at the existing design) by :func:`~railopt.design.objective_surface`, batched (one compiled call per block
-    of whole rows, :data:`~railopt.design.surface.BLOCK_POINTS` designs at most: one for 21 × 21,
+    of whole rows, about :data:`~railopt.design.surface.BLOCK_POINTS` designs: one for 21 × 21,
     :func:`~railopt.models.response_maxima.batch_response_maxima`) against the same surface of the same
     objective without ``batch_functions`` (one ``value`` per point, the solvers' path), medians of ``repeat`` runs;
     the note gives the largest relative difference (issue 25: ≥ 5× faster)."""

@@ -8,7 +8,7 @@ import pytest
 
 from railopt.design import DesignVariable, MinimaxProblem
 from railopt.design import surface as surface_module
-from railopt.design.surface import objective_surface
+from railopt.design.surface import grid_map, objective_surface
 from railopt.design.tradeoff import epsilon_sweep, nondominated
 
 
@@ -129,3 +129,45 @@ def test_row_by_row_and_batched_values_agree_on_refusals_nan_counts_and_constrai
     changing = MinimaxProblem(v, lambda x: np.ones(2 if x[0] < 0.5 else 3))
     with pytest.raises(ValueError, match="count must be fixed"):
         changing.values(X)
+
+
+def test_a_surface_without_batch_functions_is_one_task_per_row():
+    """A problem evaluated a design at a time keeps one task per row (a cluster shares the rows; progress per row)."""
+    v = [DesignVariable("a", 0.0, 1.0), DesignVariable("b", 0.0, 1.0)]
+    rows = []
+    xi, xj = np.linspace(0.0, 1.0, 21), np.linspace(0.0, 1.0, 4)
+    s = objective_surface(MinimaxProblem(v, lambda x: np.array([x[0] + 10 * x[1]])), ("a", "b"), xi, xj,
+                          [0.5, 0.5], progress=lambda done, total: rows.append((done, total)))
+    assert rows == [(k, 4) for k in range(5)]
+    np.testing.assert_array_equal(s.values, xi[None, :] + 10 * xj[:, None])
+
+
+def test_grid_rows_stay_apart_by_position_and_a_wrong_batch_is_refused():
+    """Rows are kept by position, so -0.0 and 0.0 (equal as floats) or NaN in xj each get their own values; a
+    batched fn returning another count of values than designs is a ValueError naming fn; an empty axis is an empty
+    grid."""
+    def sign(X):
+        return np.where(np.signbit(X[:, 1]), -1.0, 1.0) + 0.0 * X[:, 0]
+
+    for batched in (True, False):
+        fn = sign if batched else (lambda x: sign(x[None, :])[0])
+        grid = grid_map(fn, ["a", "b"], ("a", "b"), [0.0, 1.0], [-0.0, 0.0, np.nan], [0.5, 0.5], batched=batched)
+        np.testing.assert_array_equal(grid, [[-1.0, -1.0], [1.0, 1.0], [1.0, 1.0]])
+    with pytest.raises(ValueError, match=r"^fn: a batched fn must return one value .* per design, shape \(4,"):
+        grid_map(lambda X: np.zeros(len(X) - 1), ["a", "b"], ("a", "b"), [0.0, 1.0], [0.0, 1.0], [0.5, 0.5],
+                 batched=True)
+    with pytest.raises(ValueError, match="^fn: a batched fn"):
+        grid_map(lambda X: 42.0, ["a", "b"], ("a", "b"), [0.0], [0.0], [0.5, 0.5], batched=True)
+    assert grid_map(lambda X: X[:, 0], ["a", "b"], ("a", "b"), [], [0.0, 1.0], [0.5, 0.5], batched=True).shape == (2, 0)
+    assert grid_map(lambda x: 0.0, ["a", "b"], ("a", "b"), [0.0, 1.0], [], [0.5, 0.5]).shape == (0, 2)
+
+
+def test_values_of_designs_all_refused_before_the_count_is_known_are_inf():
+    """A fresh problem whose first designs are all refused by the model (a ValueError) gives +inf for each, not an
+    error for want of the function count."""
+    v = [DesignVariable("a", -1.0, 1.0)]
+
+    def refuse(x):
+        raise ValueError("a: refused")
+
+    np.testing.assert_array_equal(MinimaxProblem(v, refuse).values([[-0.5], [0.5]]), [np.inf, np.inf])
