@@ -188,7 +188,10 @@ class Forcing:
     @property
     def is_polynomial(self) -> bool:
         """All terms are polynomial in iΩ (the pole–residue form needs no callable per frequency)."""
-        return all(t.coefficients is not None for t in self.terms)
+        for t in self.terms:
+            if t.coefficients is None:
+                return False
+        return True
 
     def value(self, omega: float) -> np.ndarray:
         """``F(Ω)``, (n,) complex, Ω in rad/s."""

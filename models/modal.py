@@ -14,7 +14,7 @@ from functools import cached_property
 
 import numpy as np
 
-from railopt.models.kernels import c_array, left_vectors
+from railopt.models.kernels import c_array, eigen_pairs, left_vectors
 from railopt.records import ArrayRecord
 
 UNDAMPED_ROOT = 1e-12  # |Re s| / |s| below which a mode counts as undamped (its peak is inf)
@@ -73,9 +73,9 @@ class Modal(ArrayRecord):
 
 
 def modal(G: np.ndarray) -> Modal:
-    """Roots and right eigenvectors of G; the left ones (normalised W V = I) when first read."""
-    s, V = np.linalg.eig(G)
-    return Modal(s, V)
+    """Roots and right eigenvectors of a real G (those of ``np.linalg.eig``, by the compiled
+    :func:`railopt.models.kernels.eigen_pairs`); the left ones (normalised W V = I) when first read."""
+    return Modal(*eigen_pairs(c_array(G)))
 
 
 def mode_order(s: np.ndarray) -> np.ndarray:

@@ -115,13 +115,14 @@ class ResponseMaxima(ArrayRecord):
                band: tuple[float, float], **fields: object) -> ResponseMaxima:
         """The record from arrays nobody else holds (fresh from a kernel): made read-only in place, not copied."""
         self = object.__new__(cls)
-        for name, value in (("values", values), ("frequencies", frequencies),
-                            ("damped_frequencies", damped_frequencies)):
-            value.setflags(write=False)
-            object.__setattr__(self, name, value)
-        object.__setattr__(self, "band", band)
-        for f in dataclasses.fields(cls)[4:]:
-            object.__setattr__(self, f.name, fields.get(f.name, f.default))
+        values.setflags(write=False)
+        frequencies.setflags(write=False)
+        damped_frequencies.setflags(write=False)
+        state = self.__dict__  # a frozen dataclass's fields live in __dict__ (no slots)
+        state["values"], state["frequencies"], state["damped_frequencies"], state["band"] = (
+            values, frequencies, damped_frequencies, band)
+        for name, default in _TAIL_FIELDS:
+            state[name] = fields.get(name, default)
         return self
 
     @property
@@ -169,6 +170,10 @@ class ResponseMaxima(ArrayRecord):
                 "frequency_hz": rad_s_to_hz(self.frequencies),
             }
         )
+
+
+# the fields after the four arrays/band, with their defaults, for ResponseMaxima._owned
+_TAIL_FIELDS = tuple((f.name, f.default) for f in dataclasses.fields(ResponseMaxima)[4:])
 
 
 def response_maxima(system: LinearSystem, band: object = None, *, band_hz: tuple[float, float] | None = None,
@@ -401,7 +406,7 @@ def batch_response_maxima(stack: MemberStack, band: object = None, *, band_hz: t
     if chosen.feedthrough is None and B:
         M, C, K = (kernels.c_array(a) for a in (stack.M, stack.C, stack.K))
         G, regular = kernels.state_matrices(M, C, K, 1e-14)
-        s, V = np.linalg.eig(G)
+        s, V = kernels.stacked_eigen_pairs(G)
         delays = kernels.c_array(stack.delays)
         max_delay = float(np.max(delays, initial=0.0))
         count = _grid_count((lo, hi), max_delay)
@@ -434,19 +439,25 @@ def _certified(system: LinearSystem, band: tuple[float, float], names: list[str]
     outs = list(system.outputs.values())
     chosen = [outs[c] for c in cols]
     max_delay = system.max_delay
-    if not system.forcing.is_polynomial or max_delay is None or any(o.feedthrough is not None for o in chosen):
+    if max_delay is None or not system.forcing.is_polynomial:
         return None
+    for o in chosen:
+        if o.feedthrough is not None:
+            return None
     lo, hi = band
     s, V = system.eigen_pairs()
     A, delays = forcing_arrays(system.forcing, system.n)
-    rows = kernels.c_array(np.array([o.row for o in chosen], dtype=float))
-    orders = np.array([o.order for o in chosen], dtype=np.int64)
+    if len(chosen) == 1:  # the usual case, without the list round trips
+        rows = np.array(chosen[0].row[None], dtype=float)
+        orders = np.array([chosen[0].order], dtype=np.int64)
+    else:
+        rows = kernels.c_array(np.array([o.row for o in chosen], dtype=float))
+        orders = np.array([o.order for o in chosen], dtype=np.int64)
     count = _grid_count((lo, hi), max_delay)
     try:
         (status, values, freqs, ratio, points, all_finite, resonant, soft, unresolved, kappa, W, condition,
          wd) = kernels.certified_maxima(
-            kernels.c_array(system.M), kernels.c_array(system.C), kernels.c_array(system.K),
-            kernels.c_array(s, complex), kernels.c_array(V, complex), A, delays, rows, orders,
+            *system._mck, kernels.c_array(s, complex), kernels.c_array(V, complex), A, delays, rows, orders,
             float(lo), float(hi), float(max_delay), int(count), _SETTINGS)
     except np.linalg.LinAlgError:  # V or a Z(Ω) exactly singular
         return None
@@ -454,8 +465,10 @@ def _certified(system: LinearSystem, band: tuple[float, float], names: list[str]
         system.remember_left(W, condition)
     if status != kernels.CERT_OK:
         return None
-    why = _reasons(band, max_delay, ratio, all_finite, resonant, system.eigenvalues() if resonant.any() else s, wd,
-                   None if soft < 0 else s[soft], None if unresolved < 0 else s[unresolved], kappa)
+    any_resonant = np.count_nonzero(resonant) > 0  # (.any() costs µs more on these few entries)
+    why = _reasons(band, max_delay, ratio, all_finite, resonant if any_resonant else None,
+                   system.eigenvalues() if any_resonant else s, wd, None if soft < 0 else s[soft],
+                   None if unresolved < 0 else s[unresolved], kappa)
     return {nm: ResponseMaxima._owned(values[i], freqs[i], wd, (lo, hi), exact=True, certified=not why,
                                       grid_ratio=float(ratio), output=nm, evaluation="pole-residue",
                                       grid_points=int(points), reason="; ".join(why))
@@ -479,7 +492,7 @@ def _uncertified(system: LinearSystem, modal, roots: np.ndarray, resonant: np.nd
 
 
 def _reasons(band: tuple[float, float], max_delay: float | None, ratio: float, all_finite: bool,
-             resonant: np.ndarray, roots: np.ndarray, wd: np.ndarray, soft_root: complex | None,
+             resonant: np.ndarray | None, roots: np.ndarray, wd: np.ndarray, soft_root: complex | None,
              pole: complex | None, kappa: float) -> list[str]:
     """The wording of why the cell maxima are not certified, from the checks' outcomes (empty when certified)."""
     why = []
@@ -492,7 +505,7 @@ def _reasons(band: tuple[float, float], max_delay: float | None, ratio: float, a
             if needed > MAX_GRID_POINTS else ""))
     if not all_finite:
         why.append("a sample was singular (an undamped or rigid-body pole on the band)")
-    if resonant.any():
+    if resonant is not None and resonant.any():
         j = int(np.flatnonzero(resonant)[0])
         mode = roots[1::2][j]
         why.append(f"mode {j + 1} at {wd[j] / (2 * np.pi):.6g} Hz has damping ratio {abs(mode.real) / abs(mode):.3g} "

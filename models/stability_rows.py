@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from railopt.models import kernels
 from railopt.models.modal import mode_order, neutral_roots
 from railopt.models.mode_names import _body_dof, _shares, _track_body, named_modes
 from railopt.models.sensitivity import (
@@ -92,7 +93,7 @@ def _family_rows(family: ParametricSystem, p: Sequence[float] | None, speeds: Se
     G = np.zeros((K, 2 * n, 2 * n))
     G[:, :n, n:] = np.eye(n)
     G[:, n:, :] = -AB
-    s, V = np.linalg.eig(G)  # numpy loops over the stack in C
+    s, V = kernels.stacked_eigen_pairs(G)
     idx = mode_order(s)[:, 1::2]  # mode_order sorts each row of a stack alone
     shapes = np.take_along_axis(V[:, :n, :], idx[:, None, :], axis=2)  # (K, n, n): coordinates × modes
     shares = _shares(member, shapes.transpose(1, 0, 2).reshape(n, K * n)).reshape(n, K, n)  # M shared by all

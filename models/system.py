@@ -19,8 +19,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.linalg as sla
 
+from railopt.models import response_maxima as maxima
 from railopt.models.forcing import Forcing, ForcingLike, as_forcing
-from railopt.models.kernels import c_array, direct_solutions, member_state
+from railopt.models.kernels import c_array, direct_solutions, member_state, state_eigen_pairs, state_matrix
 from railopt.models.modal import CONDITION_LIMIT, UNDAMPED_ROOT, Modal, modal, mode_order
 from railopt.models.pole_residue import PoleResidue
 from railopt.models.validation import frequencies_arg, real_array, square_matrix
@@ -135,7 +136,9 @@ class LinearSystem:
 
     def _prepare(self) -> None:
         """M⁻¹[K C] for the state matrix (4.53); a singular M is an error naming the field."""
-        self._minv_kc, regular = member_state(c_array(self.M), c_array(self.K), c_array(self.C), 1e-14)
+        # M, C, K as the kernels take them (C-contiguous float64, copied only when not already so)
+        self._mck = (c_array(self.M), c_array(self.C), c_array(self.K))
+        self._minv_kc, regular = member_state(self._mck[0], self._mck[2], self._mck[1], 1e-14)
         if not regular:
             raise ValueError("M: is singular (a coordinate without inertia); eliminate it first")
         self._eigvals: np.ndarray | None = None
@@ -195,11 +198,7 @@ class LinearSystem:
     # ------------------------------------------------------------------ eigen-analysis (4.51-4.58)
     def state_matrix(self) -> np.ndarray:
         """State matrix ``G = [[0, I], [-M⁻¹K, -M⁻¹C]]`` of thesis eq. (4.53), shape (2n, 2n)."""
-        n = self.n
-        G = np.zeros((2 * n, 2 * n))
-        G[:n, n:] = np.eye(n)
-        G[n:, :] = -self._minv_kc
-        return G
+        return state_matrix(self._minv_kc)
 
     def modal(self) -> Modal:
         """Roots s of G with right (V) and left (W = V⁻¹) eigenvectors, cached (eqs. 4.56-4.58)."""
@@ -210,12 +209,13 @@ class LinearSystem:
         return self._modal
 
     def eigen_pairs(self) -> tuple[np.ndarray, np.ndarray]:
-        """(s (2n,), V (2n, 2n)) of ``np.linalg.eig(G)``, cached, without building the :class:`Modal` record (the
+        """(s (2n,), V (2n, 2n)) complex128 of ``np.linalg.eig(G)`` (bit for bit, by the compiled
+        :func:`railopt.models.kernels.state_eigen_pairs`), cached, without building the :class:`Modal` record (the
         compiled certified path takes the arrays as they are); the same arrays :meth:`modal` then holds."""
         if self._modal is not None:
             return self._modal.s, self._modal.V
         if self._eig is None:
-            self._eig = np.linalg.eig(self.state_matrix())
+            self._eig = state_eigen_pairs(self._minv_kc)
         return self._eig
 
     def remember_left(self, W: np.ndarray, condition: float) -> None:
@@ -322,7 +322,7 @@ class LinearSystem:
         w = frequencies_arg(omega, frequencies_hz, omega_rad_s)
         F = np.array([self.forcing_at(float(x)) for x in w], dtype=complex).reshape(len(w), self.n)
         try:
-            X, overflow = direct_solutions(c_array(self.M), c_array(self.C), c_array(self.K), c_array(w),
+            X, overflow = direct_solutions(*self._mck, c_array(w),
                                            c_array(F, complex))
         except np.linalg.LinAlgError:  # a singular Z somewhere: point by point with pivot checks
             X, overflow = self.solve_many(w), np.zeros(len(w), dtype=bool)
@@ -345,9 +345,13 @@ class LinearSystem:
     @property
     def max_delay(self) -> float | None:
         """Largest declared delay of the forcing and the feedthroughs (s); None if any is undeclared."""
-        delays = [self.forcing.max_delay] + [o.feedthrough.max_delay for o in self.outputs.values()
-                                             if o.feedthrough is not None]
-        return None if any(d is None for d in delays) else max(delays)
+        largest = self.forcing.max_delay
+        for o in self.outputs.values():
+            if o.feedthrough is not None:
+                if largest is None or o.feedthrough.max_delay is None:
+                    return None
+                largest = max(largest, o.feedthrough.max_delay)
+        return largest
 
     def output_index(self, output: str | None) -> int:
         """Column of ``output`` in :meth:`frf_outputs` (0 for the default)."""
@@ -374,17 +378,13 @@ class LinearSystem:
                         output: str | None = None) -> ResponseMaxima:
         """The n+2 response maxima f_k of (4.71)-(4.73) over ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s);
         see :func:`railopt.models.response_maxima.response_maxima`."""
-        from railopt.models.response_maxima import response_maxima
-
-        return response_maxima(self, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, output=output)
+        return maxima.response_maxima(self, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, output=output)
 
     def peak(self, band: object = None, *, band_hz: tuple[float, float] | None = None,
              band_rad_s: tuple[float, float] | None = None, exact: bool = True, output: str | None = None) -> float:
         """``U = max_k f_k`` (4.74) over ``band_hz=`` (Hz) or ``band_rad_s=`` (rad/s);
         see :func:`railopt.models.response_maxima.peak`."""
-        from railopt.models.response_maxima import peak
-
-        return peak(self, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, output=output)
+        return maxima.peak(self, band, band_hz=band_hz, band_rad_s=band_rad_s, exact=exact, output=output)
 
 
 @dataclass(frozen=True, eq=False)

@@ -202,7 +202,8 @@ def test_each_kernel_keeps_one_compiled_signature():
     sys.frf(omega_rad_s=[1, 2])
     for kernel in (kernels.band_grid, kernels.pole_residue_magnitudes, kernels.cell_maxima_pole_residue,
                    kernels.pole_residue_sums, kernels.vertex_start, kernels.brent_start, kernels.member_state,
-                   kernels.left_vectors, kernels.residues, kernels.direct_solutions):
+                   kernels.left_vectors, kernels.residues, kernels.direct_solutions, kernels.eigen_pairs,
+                   kernels.state_eigen_pairs, kernels.state_matrix):
         assert len(kernel.signatures) <= 1, kernel
 
 
@@ -225,6 +226,97 @@ def test_member_state_and_left_vectors_against_scipy():
     W, cond = kernels.left_vectors(np.ascontiguousarray(V))
     np.testing.assert_allclose(W, sla.inv(V), rtol=1e-12, atol=1e-12 * np.abs(W).max())
     assert abs(cond - np.linalg.cond(V, 1)) <= 1e-12 * cond
+
+
+def _eig_cases() -> list[np.ndarray]:
+    """Real square matrices of each kind LAPACK's dgeev meets: complex pairs, all real roots, a mix, a defective
+    Jordan block, repeated roots, a zero matrix, a 1×1, random dense ones of several sizes."""
+    rng = np.random.default_rng(7)
+    cases = [rng.standard_normal((N, N)) for N in (1, 2, 3, 6, 18, 40)]
+    cases.append(np.diag([3.0, -1.0, 2.0, 0.5]) + np.triu(rng.standard_normal((4, 4)), 1))  # all real
+    cases.append(np.array([[0.0, 1.0], [0.0, 0.0]]))  # a Jordan block at 0
+    cases.append(np.kron(np.eye(3), np.array([[0.0, 1.0], [-4.0, -0.1]])))  # a triple complex pair
+    cases.append(np.zeros((5, 5)))
+    M, C, K, *_ = chain(7, seed=2)
+    cases.append(LinearSystem(M, C, K, np.ones(7), np.ones(7)).state_matrix())
+    return cases
+
+
+def test_compiled_eigen_pairs_are_numpys_eig_bit_for_bit():
+    """kernels.eigen_pairs calls the same LAPACK dgeev as np.linalg.eig and pairs its real output the same way:
+    roots and vectors equal numpy's exactly (complex128 always), one by one and stacked; and each pair is an
+    eigen-pair (residual ‖GV − V diag(s)‖ at rounding)."""
+    for G in _eig_cases():
+        s_ref, V_ref = np.linalg.eig(G)
+        s, V = kernels.eigen_pairs(np.ascontiguousarray(G))
+        assert s.dtype == V.dtype == np.complex128
+        np.testing.assert_array_equal(s, s_ref)
+        np.testing.assert_array_equal(V, V_ref)
+        scale = max(np.abs(G).max(), 1.0)
+        assert np.abs(G @ V - V * s).max() <= 1e-12 * scale * max(np.abs(V).max(), 1.0)
+    G = np.random.default_rng(3).standard_normal((4, 6, 6))
+    s, V = kernels.stacked_eigen_pairs(G)
+    s_ref, V_ref = np.linalg.eig(G)
+    np.testing.assert_array_equal(s, s_ref)
+    np.testing.assert_array_equal(V, V_ref)
+    s, V = kernels.eigen_pairs(np.zeros((0, 0)))
+    assert s.shape == (0,) and V.shape == (0, 0)
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_compiled_eigen_pairs_refuse_non_finite_entries_as_numpy_does(bad):
+    """A NaN or infinite entry raises numpy's LinAlgError, as ``np.linalg.eig`` does (never a NaN root)."""
+    G = np.eye(3)
+    G[1, 2] = bad
+    with pytest.raises(np.linalg.LinAlgError):
+        np.linalg.eig(G)
+    with pytest.raises(np.linalg.LinAlgError, match="infs or NaNs"):
+        kernels.eigen_pairs(G)
+
+
+def test_state_matrix_kernel_is_the_thesis_block_form():
+    """G = [[0, I], [−M⁻¹K, −M⁻¹C]] (thesis eq. 4.53) built here with numpy's solve, against the kernel's (and
+    LinearSystem.state_matrix, which is the kernel), and its eigen-pairs against numpy's eig of that G."""
+    M, C, K, *_ = chain(4, seed=9)
+    G_ref = np.block([[np.zeros((4, 4)), np.eye(4)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    sys = LinearSystem(M, C, K, np.ones(4), np.ones(4))
+    np.testing.assert_allclose(sys.state_matrix(), G_ref, rtol=1e-14, atol=1e-14 * np.abs(G_ref).max())
+    s, V = sys.eigen_pairs()
+    s_ref, V_ref = np.linalg.eig(sys.state_matrix())
+    np.testing.assert_array_equal(s, s_ref)
+    np.testing.assert_array_equal(V, V_ref)
+
+
+def test_magnitude_is_abs_to_two_ulps_and_inf_where_not_finite():
+    """kernels.magnitude (√(re² + im²) where the squares are safe, else abs) against numpy's abs (hypot): within
+    two ulps (three roundings, halved by the root, plus the root's own) on random values of every scale, exactly
+    abs where the squares over- or underflow, +inf for inf or NaN parts."""
+    rng = np.random.default_rng(5)
+    z = (rng.standard_normal(2000) + 1j * rng.standard_normal(2000)) * 10.0 ** rng.uniform(-150, 150, 2000)
+    ours = np.array([kernels.magnitude(complex(x)) for x in z])
+    assert np.all(np.abs(ours - np.abs(z)) <= 2 * np.spacing(np.abs(z)))
+    for x in (1e200 + 1e200j, 3e-200 - 4e-200j, 1e-320 + 0j, 0j):
+        assert kernels.magnitude(x) == abs(x)
+    for x in (complex(np.inf, 1.0), complex(1.0, np.nan), complex(np.nan, np.nan)):
+        assert kernels.magnitude(x) == np.inf
+
+
+def test_band_grid_pole_points_are_the_sinh_formula():
+    """The per-pole points stepped by the exponential recurrence equal ω + σ·sinh(u0 + i·δ) (numpy's sinh, here)
+    to the recurrence's drift (a few ulps per step, of σ·cosh(u)): for each pole of a lightly damped chain, every
+    such point lies in the grid within that distance."""
+    M, C, K, A, delays, rows, q = chain(6, seed=8)
+    s, _ = residues(M, C, K, A, rows)
+    lo, hi, step = 0.0, 4.0, 0.2  # POLE_STEP
+    grid, _ = band_grid(s, (lo, hi), max_delay=0.7)
+    for pole in s[s.imag > 0]:
+        sigma, omega = abs(pole.real), pole.imag
+        u0, u1 = np.arcsinh((lo - omega) / sigma), np.arcsinh((hi - omega) / sigma)
+        u = u0 + np.arange(int(np.ceil((u1 + step - u0) / step))) * step
+        points = np.clip(omega + sigma * np.sinh(u), lo, hi)
+        gap = np.min(np.abs(points[:, None] - grid[None, :]), axis=1)
+        drift = 4 * (len(u) + 4) * np.finfo(float).eps
+        assert np.all(gap <= drift * np.maximum(np.abs(points), sigma * np.cosh(u)))
 
 
 def test_compiled_residues_and_direct_solutions_equal_dense_solves():
