@@ -2,7 +2,7 @@
 
 What lives here, each written once:
 
-- :func:`eigen_pairs` (numpy's ``eig`` of a real matrix, bit for bit, by the same LAPACK dgeev without numpy's
+- :func:`eigen_pairs` (``np.linalg.eig`` of a real matrix, LAPACK dgeev from scipy's build, without numpy's
   per-call cost; :func:`state_eigen_pairs` of the state matrix, :func:`stacked_eigen_pairs` of a stack) and
   :func:`state_matrix` (G of thesis eq. 4.53);
 - :func:`member_state` (M⁻¹[K C] with the regularity check of M), :func:`left_vectors` (W = V⁻¹ and cond₁(V)),
@@ -103,7 +103,7 @@ def member_state(M: np.ndarray, K: np.ndarray, C: np.ndarray, singular_pivot: fl
     return np.ascontiguousarray(np.linalg.solve(M, KC)), True
 
 
-# numba's own binding of LAPACK dgeev (scipy's cython_lapack, the library numpy's eig calls too), found by its
+# numba's own binding of LAPACK dgeev (scipy's cython_lapack: scipy's OpenBLAS build, not numpy's), found by its
 # symbol name so that the kernels that call it stay cacheable (a ctypes pointer would not be)
 _RGEEV = types.ExternalFunction("numba_ez_rgeev", types.intc(
     types.char, types.char, types.char, types.intp, types.CPointer(types.float64), types.intp,
@@ -113,25 +113,48 @@ _RGEEV = types.ExternalFunction("numba_ez_rgeev", types.intc(
 
 @njit(**JIT)
 def eigen_pairs(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Roots s (N,) and right eigenvectors V (N, N, columns) of a real square G (N, N), both complex128: what
-    ``np.linalg.eig(G)`` returns (the same LAPACK dgeev with jobvl = 'N', jobvr = 'V', and numpy's pairing of its
-    real output: a pair wr ± i·wi takes columns v_re ± i·v_im), bit for bit, without numpy's per-call cost.
+    """Roots s (N,) and right eigenvectors V (N, N, columns) of a real square G (N, N), both complex128, as
+    ``np.linalg.eig(G)`` gives them: LAPACK dgeev with jobvl = 'N', jobvr = 'V' and numpy's pairing of its real
+    output (a pair wr ± i·wi takes columns v_re ± i·v_im), without numpy's per-call cost.  The dgeev is scipy's
+    OpenBLAS build (numba's binding): the result equals ``scipy.linalg.eig(G)``'s bit for bit and numpy's to
+    rounding (bit for bit on the tests' matrices with one BLAS thread, as railopt's tasks run).
 
-    Raises numpy's ``LinAlgError`` when G holds inf or NaN or the QR iteration does not converge."""
+    That build's dgeev does not undo its own scaling of a matrix whose largest entry lies outside about
+    [6.7e-139, 1.5e138] (its roots come back off by the scale factor), so such a G is first scaled here by a power
+    of two, exactly, to a largest entry in [0.5, 1), and the roots scaled back (the vectors do not change).
+
+    Raises numpy's ``LinAlgError`` when G is not square, holds inf or NaN, or LAPACK fails (no convergence of the
+    QR iteration, or a refused argument)."""
     N = G.shape[0]
-    a = np.empty((N, N))  # C order holding Gᵀ: LAPACK reads it as G in Fortran order
+    if G.shape[1] != N:
+        raise np.linalg.LinAlgError("Last 2 dimensions of the array must be square")
+    largest = 0.0
     for i in range(N):
         for j in range(N):
             if not math.isfinite(G[i, j]):
                 raise np.linalg.LinAlgError("Array must not contain infs or NaNs")
-            a[j, i] = G[i, j]
+            largest = max(largest, abs(G[i, j]))
+    scale = 1.0
+    if largest > 2.0**400 or 0.0 < largest < 2.0**-400:
+        scale = math.ldexp(1.0, -math.frexp(largest)[1])
+    a = np.empty((N, N))  # C order holding Gᵀ: LAPACK reads it as G in Fortran order
+    for i in range(N):
+        for j in range(N):
+            a[j, i] = G[i, j] * scale
     wr, wi, vl, vr = np.empty(N), np.empty(N), np.empty((1, 1)), np.empty((N, N))  # vr holds Vᵀ (Fortran)
     s = np.empty(N, np.complex128)
     V = np.empty((N, N), np.complex128)
     if N == 0:
         return s, V
-    if _RGEEV(ord("d"), ord("N"), ord("V"), N, a.ctypes, N, wr.ctypes, wi.ctypes, vl.ctypes, 1, vr.ctypes, N):
+    info = _RGEEV(ord("d"), ord("N"), ord("V"), N, a.ctypes, N, wr.ctypes, wi.ctypes, vl.ctypes, 1, vr.ctypes, N)
+    if info > 0:
         raise np.linalg.LinAlgError("Eigenvalues did not converge")
+    if info < 0:
+        raise np.linalg.LinAlgError("LAPACK dgeev refused an argument or could not allocate its workspace")
+    if scale != 1.0:
+        for k in range(N):
+            wr[k] /= scale
+            wi[k] /= scale
     k = 0
     while k < N:
         if wi[k] == 0.0:
@@ -170,7 +193,8 @@ def state_matrix(minv_kc: np.ndarray) -> np.ndarray:
 
 @njit(**JIT)
 def stacked_eigen_pairs(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`eigen_pairs` of every matrix of a stack G (B, N, N): s (B, N), V (B, N, N) complex128."""
+    """:func:`eigen_pairs` of every matrix of a stack G (B, N, N): s (B, N), V (B, N, N) complex128 (raises as
+    :func:`eigen_pairs` does)."""
     B, N = G.shape[0], G.shape[1]
     s = np.empty((B, N), np.complex128)
     V = np.empty((B, N, N), np.complex128)

@@ -73,8 +73,11 @@ class Modal(ArrayRecord):
 
 
 def modal(G: np.ndarray) -> Modal:
-    """Roots and right eigenvectors of a real G (those of ``np.linalg.eig``, by the compiled
-    :func:`railopt.models.kernels.eigen_pairs`); the left ones (normalised W V = I) when first read."""
+    """Roots and right eigenvectors of G (N, N), those of ``np.linalg.eig`` (a real G by the compiled
+    :func:`railopt.models.kernels.eigen_pairs`, a complex one by numpy); the left ones (normalised W V = I) when
+    first read."""
+    if np.iscomplexobj(G):
+        return Modal(*np.linalg.eig(G))
     return Modal(*eigen_pairs(c_array(G)))
 
 

@@ -93,7 +93,7 @@ def forcing_arrays(forcing: Forcing, n: int) -> tuple[np.ndarray, np.ndarray]:
     in s."""
     terms = forcing.terms
     if len(terms) == 1 and terms[0].coefficients is not None:  # one term (a constant amplitude, say): one copy
-        return np.array(terms[0].coefficients[None], dtype=complex), np.array([terms[0].delay])
+        return np.array(terms[0].coefficients[None], dtype=complex), np.array([terms[0].delay], dtype=float)
     poly = [t for t in terms if t.coefficients is not None]
     delays = np.array([t.delay for t in poly], dtype=float)
     degrees = {t.coefficients.shape[0] for t in poly}

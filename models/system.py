@@ -209,7 +209,7 @@ class LinearSystem:
         return self._modal
 
     def eigen_pairs(self) -> tuple[np.ndarray, np.ndarray]:
-        """(s (2n,), V (2n, 2n)) complex128 of ``np.linalg.eig(G)`` (bit for bit, by the compiled
+        """(s (2n,), V (2n, 2n)) complex128 of ``np.linalg.eig(G)`` (to rounding, by the compiled
         :func:`railopt.models.kernels.state_eigen_pairs`), cached, without building the :class:`Modal` record (the
         compiled certified path takes the arrays as they are); the same arrays :meth:`modal` then holds."""
         if self._modal is not None:

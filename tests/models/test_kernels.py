@@ -242,25 +242,100 @@ def _eig_cases() -> list[np.ndarray]:
     return cases
 
 
-def test_compiled_eigen_pairs_are_numpys_eig_bit_for_bit():
-    """kernels.eigen_pairs calls the same LAPACK dgeev as np.linalg.eig and pairs its real output the same way:
-    roots and vectors equal numpy's exactly (complex128 always), one by one and stacked; and each pair is an
-    eigen-pair (residual ‖GV − V diag(s)‖ at rounding)."""
+def test_compiled_eigen_pairs_are_lapack_dgeev_as_numpy_pairs_it():
+    """kernels.eigen_pairs calls LAPACK dgeev (scipy's build) and pairs its real output as numpy does: roots and
+    vectors equal ``scipy.linalg.eig``'s exactly (the same routine of the same library; complex128 always), one by
+    one and stacked; each pair is an eigen-pair (residual ‖GV − V diag(s)‖ at rounding); and the roots of the
+    non-defective cases are numpy's (another OpenBLAS build) to rounding, matched root by root."""
+    import scipy.linalg as sla
+
     for G in _eig_cases():
-        s_ref, V_ref = np.linalg.eig(G)
+        s_ref, V_ref = sla.eig(G)
         s, V = kernels.eigen_pairs(np.ascontiguousarray(G))
         assert s.dtype == V.dtype == np.complex128
         np.testing.assert_array_equal(s, s_ref)
         np.testing.assert_array_equal(V, V_ref)
         scale = max(np.abs(G).max(), 1.0)
         assert np.abs(G @ V - V * s).max() <= 1e-12 * scale * max(np.abs(V).max(), 1.0)
+        if np.linalg.cond(V) < 1e6:  # a well-conditioned eigenbasis: the roots are well determined
+            s_np = np.linalg.eigvals(G)
+            gap = np.abs(s[:, None] - s_np[None, :]).min(axis=1)
+            assert gap.max() <= 1e-12 * max(np.abs(s).max(), 1e-300)
     G = np.random.default_rng(3).standard_normal((4, 6, 6))
     s, V = kernels.stacked_eigen_pairs(G)
-    s_ref, V_ref = np.linalg.eig(G)
-    np.testing.assert_array_equal(s, s_ref)
-    np.testing.assert_array_equal(V, V_ref)
+    for b in range(4):
+        s_ref, V_ref = sla.eig(G[b])
+        np.testing.assert_array_equal(s[b], s_ref)
+        np.testing.assert_array_equal(V[b], V_ref)
     s, V = kernels.eigen_pairs(np.zeros((0, 0)))
     assert s.shape == (0,) and V.shape == (0, 0)
+
+
+@pytest.mark.parametrize("exponent", [-1000, -600, -461, -300, -140, 0, 140, 300, 459, 600, 1000])
+def test_compiled_eigen_pairs_keep_their_scale_far_from_one(exponent):
+    """A damped oscillator's state matrix times 2^e (exact) has the roots 2^e·(−ζω ± iω√(1−ζ²)) — the closed form,
+    to 1e-14 — at every scale a double holds, also where LAPACK's own scaling of the matrix (largest entry outside
+    about [6.7e-139, 1.5e138]) is not undone by the library's dgeev; the vectors are those of the unscaled
+    matrix to rounding."""
+    zeta, omega = 0.05, 1.0
+    G0 = np.array([[0.0, 1.0], [-omega**2, -2 * zeta * omega]])
+    G = np.ldexp(G0, exponent)
+    assert np.isfinite(G).all() and np.abs(G).max() > 0
+    s, V = kernels.eigen_pairs(G)
+    exact = np.ldexp(1.0, exponent) * omega * (-zeta + 1j * np.sqrt(1 - zeta**2) * np.array([1.0, -1.0]))
+    assert np.abs(np.sort_complex(s) - np.sort_complex(exact)).max() <= 1e-14 * np.abs(exact).max()
+    _, V0 = kernels.eigen_pairs(G0)
+    assert np.abs(np.abs(V) - np.abs(V0)).max() <= 1e-14
+
+
+def test_a_system_at_an_extreme_scale_keeps_its_modes_and_an_honest_maximum():
+    """Stiffnesses of 1e140 (ω ≈ 1e70 rad/s), where the library's dgeev alone returned roots 2000× too low and a
+    band maximum half the true one marked certified: the damped frequencies are numpy's (its eig scales correctly)
+    to 1e-12, and the maximum is not below a 400,001-point dense sweep of direct solves (numpy) — equal to it to
+    the sweep's resolution."""
+    M = np.diag([1.0, 2.0])
+    K = 1e140 * np.array([[30.0, -10.0], [-10.0, 10.0]])
+    C = 1e68 * np.array([[3.0, -1.0], [-1.0, 1.0]])
+    sys = LinearSystem(M, C, K, [1.0, 0.0], [1.0, 0.0])
+    G = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    wd = np.sort(np.abs(np.linalg.eigvals(G).imag))[1::2]
+    np.testing.assert_allclose(np.sort(sys.damped_frequencies()), wd, rtol=1e-12)
+    band = (8.86e69, 1.13e71)
+    rm = response_maxima(sys, band_rad_s=band, exact=True)
+    w = np.linspace(*band, 400_001)
+    Z = K[None] - w[:, None, None] ** 2 * M[None] + 1j * w[:, None, None] * C[None]
+    dense = np.abs(np.linalg.solve(Z, np.broadcast_to([[1.0], [0.0]], (len(w), 2, 1)).astype(complex))[:, 0, 0])
+    assert rm.value >= dense.max() * (1 - 1e-12)
+    assert rm.value <= dense.max() * (1 + 1e-4)
+
+
+def test_modal_of_a_complex_matrix_is_numpys_eig():
+    """modal(G) of a complex G (outside the real kernel's domain) is numpy's eig of it, never of its real part."""
+    from railopt.models.modal import modal
+
+    G = np.array([[0.0, 1j], [1.0, 0.0]])
+    s_ref, V_ref = np.linalg.eig(G)
+    m = modal(G)
+    np.testing.assert_array_equal(m.s, s_ref)
+    np.testing.assert_array_equal(m.V, V_ref)
+
+
+def test_a_one_term_forcing_gives_the_kernels_float_delays():
+    """forcing_arrays of a hand-built one-term forcing with an integer delay gives float64 delays (the kernels'
+    one signature) and complex128 coefficients (T, J, n)."""
+    from railopt.models.forcing import DelayedTerm
+    from railopt.models.pole_residue import forcing_arrays
+
+    A, delays = forcing_arrays(Forcing(terms=[DelayedTerm(0, coefficients=np.ones((1, 3), dtype=complex))]), 3)
+    assert delays.dtype == np.float64 and delays.tolist() == [0.0]
+    assert A.dtype == np.complex128 and A.shape == (1, 1, 3)
+
+
+def test_compiled_eigen_pairs_refuse_a_non_square_matrix():
+    """A 2×3 or 3×2 G raises numpy's LinAlgError (never the eigenvalues of a corner, or memory past the end)."""
+    for shape in ((2, 3), (3, 2)):
+        with pytest.raises(np.linalg.LinAlgError, match="square"):
+            kernels.eigen_pairs(np.ones(shape))
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
@@ -276,15 +351,18 @@ def test_compiled_eigen_pairs_refuse_non_finite_entries_as_numpy_does(bad):
 
 def test_state_matrix_kernel_is_the_thesis_block_form():
     """G = [[0, I], [−M⁻¹K, −M⁻¹C]] (thesis eq. 4.53) built here with numpy's solve, against the kernel's (and
-    LinearSystem.state_matrix, which is the kernel), and its eigen-pairs against numpy's eig of that G."""
+    LinearSystem.state_matrix, which is the kernel), its eigen-pairs those of the kernel on that G, and its roots
+    numpy's eigvals of the G built here to rounding."""
     M, C, K, *_ = chain(4, seed=9)
     G_ref = np.block([[np.zeros((4, 4)), np.eye(4)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     sys = LinearSystem(M, C, K, np.ones(4), np.ones(4))
     np.testing.assert_allclose(sys.state_matrix(), G_ref, rtol=1e-14, atol=1e-14 * np.abs(G_ref).max())
     s, V = sys.eigen_pairs()
-    s_ref, V_ref = np.linalg.eig(sys.state_matrix())
+    s_ref, V_ref = kernels.eigen_pairs(sys.state_matrix())
     np.testing.assert_array_equal(s, s_ref)
     np.testing.assert_array_equal(V, V_ref)
+    gap = np.abs(s[:, None] - np.linalg.eigvals(G_ref)[None, :]).min(axis=1)
+    assert gap.max() <= 1e-12 * np.abs(s).max()
 
 
 def test_magnitude_is_abs_to_two_ulps_and_inf_where_not_finite():
