@@ -91,10 +91,7 @@ def forcing_arrays(forcing: Forcing, n: int) -> tuple[np.ndarray, np.ndarray]:
     """The polynomial terms of ``forcing`` stacked for the kernels: A (T, J, n) complex128 with
     ``F(Ω) = Σ_t e^{−iΩ delays[t]} Σ_j (iΩ)^j A[t, j]`` (thesis eqs. 4.63–4.66; callable terms left out), delays (T,)
     in s."""
-    terms = forcing.terms
-    if len(terms) == 1 and terms[0].coefficients is not None:  # one term (a constant amplitude, say): one copy
-        return np.array(terms[0].coefficients[None], dtype=complex), np.array([terms[0].delay], dtype=float)
-    poly = [t for t in terms if t.coefficients is not None]
+    poly = [t for t in forcing.terms if t.coefficients is not None]
     delays = np.array([t.delay for t in poly], dtype=float)
     degrees = {t.coefficients.shape[0] for t in poly}
     if len(degrees) == 1:  # every term of one degree (the usual case): one stacking copy

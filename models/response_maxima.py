@@ -447,12 +447,8 @@ def _certified(system: LinearSystem, band: tuple[float, float], names: list[str]
     lo, hi = band
     s, V = system.eigen_pairs()
     A, delays = forcing_arrays(system.forcing, system.n)
-    if len(chosen) == 1:  # the usual case, without the list round trips
-        rows = np.array(chosen[0].row[None], dtype=float)
-        orders = np.array([chosen[0].order], dtype=np.int64)
-    else:
-        rows = kernels.c_array(np.array([o.row for o in chosen], dtype=float))
-        orders = np.array([o.order for o in chosen], dtype=np.int64)
+    rows = np.array([o.row for o in chosen], dtype=float)  # a fresh C-contiguous copy, as the kernel takes it
+    orders = np.array([o.order for o in chosen], dtype=np.int64)
     count = _grid_count((lo, hi), max_delay)
     try:
         (status, values, freqs, ratio, points, all_finite, resonant, soft, unresolved, kappa, W, condition,
@@ -465,9 +461,8 @@ def _certified(system: LinearSystem, band: tuple[float, float], names: list[str]
         system.remember_left(W, condition)
     if status != kernels.CERT_OK:
         return None
-    any_resonant = np.count_nonzero(resonant) > 0  # (.any() costs µs more on these few entries)
-    why = _reasons(band, max_delay, ratio, all_finite, resonant if any_resonant else None,
-                   system.eigenvalues() if any_resonant else s, wd, None if soft < 0 else s[soft],
+    why = _reasons(band, max_delay, ratio, all_finite, resonant,
+                   system.eigenvalues() if np.count_nonzero(resonant) else s, wd, None if soft < 0 else s[soft],
                    None if unresolved < 0 else s[unresolved], kappa)
     return {nm: ResponseMaxima._owned(values[i], freqs[i], wd, (lo, hi), exact=True, certified=not why,
                                       grid_ratio=float(ratio), output=nm, evaluation="pole-residue",
@@ -492,7 +487,7 @@ def _uncertified(system: LinearSystem, modal, roots: np.ndarray, resonant: np.nd
 
 
 def _reasons(band: tuple[float, float], max_delay: float | None, ratio: float, all_finite: bool,
-             resonant: np.ndarray | None, roots: np.ndarray, wd: np.ndarray, soft_root: complex | None,
+             resonant: np.ndarray, roots: np.ndarray, wd: np.ndarray, soft_root: complex | None,
              pole: complex | None, kappa: float) -> list[str]:
     """The wording of why the cell maxima are not certified, from the checks' outcomes (empty when certified)."""
     why = []
@@ -505,7 +500,7 @@ def _reasons(band: tuple[float, float], max_delay: float | None, ratio: float, a
             if needed > MAX_GRID_POINTS else ""))
     if not all_finite:
         why.append("a sample was singular (an undamped or rigid-body pole on the band)")
-    if resonant is not None and resonant.any():
+    if np.count_nonzero(resonant):  # (.any() costs µs more on these few entries)
         j = int(np.flatnonzero(resonant)[0])
         mode = roots[1::2][j]
         why.append(f"mode {j + 1} at {wd[j] / (2 * np.pi):.6g} Hz has damping ratio {abs(mode.real) / abs(mode):.3g} "

@@ -90,9 +90,7 @@ def _family_rows(family: ParametricSystem, p: Sequence[float] | None, speeds: Se
     n, K = member.n, len(speeds)
     C = _damping_stack(member, speeds)
     AB = np.linalg.solve(member.M, np.concatenate([np.broadcast_to(member.K, C.shape), C], axis=2))
-    G = np.zeros((K, 2 * n, 2 * n))
-    G[:, :n, n:] = np.eye(n)
-    G[:, n:, :] = -AB
+    G = np.array([kernels.state_matrix(kernels.c_array(ab)) for ab in AB])  # M⁻¹[K C(S_k)] → G(S_k), eq. 4.53
     s, V = kernels.stacked_eigen_pairs(G)
     idx = mode_order(s)[:, 1::2]  # mode_order sorts each row of a stack alone
     shapes = np.take_along_axis(V[:, :n, :], idx[:, None, :], axis=2)  # (K, n, n): coordinates × modes

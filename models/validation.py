@@ -20,8 +20,8 @@ from railopt.models.units import RAD_PER_HZ
 
 def number(name: str, value: object, *, positive: bool = False, non_negative: bool = False) -> float:
     """A finite real number (Python or numpy scalar, not bool), optionally > 0 or ≥ 0."""
-    if type(value) is float:  # the common case, without the abstract-class checks (they cost µs per call)
-        v = value
+    if isinstance(value, float):  # the common case (numpy's float64 too), without the abstract-class checks (µs)
+        v = float(value)
     elif isinstance(value, bool | np.bool_) or not isinstance(value, Real | np.floating | np.integer):
         raise ValueError(f"{name}: must be a real number, got {value!r}")
     else:
@@ -152,10 +152,6 @@ def band_arg(positional: object = None, band_hz: object = None, band_rad_s: obje
     """The one frequency convention of railopt's public API: a band is given as ``band_hz=(lo, hi)`` in Hz or
     ``band_rad_s=(lo, hi)`` in rad/s (exactly one); a positional ``band`` is refused, because (0.2, 5.0) in Hz
     read as rad/s gives a 13× different answer without any sign of it.  Returns (lo, hi) in rad/s."""
-    if positional is None and band_hz is None and type(band_rad_s) is tuple and len(band_rad_s) == 2:
-        lo, hi = band_rad_s  # the common call, checked as band() checks it without its generic conversions
-        if isinstance(lo, float) and isinstance(hi, float) and 0.0 <= lo < hi < math.inf:  # numpy's float64 too
-            return float(lo), float(hi)
     lo, hi = _in_rad_s(positional, band_hz, band_rad_s, ("band", "band_hz", "band_rad_s"), band)
     return float(lo), float(hi)
 
