@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Callable, Sequence
+import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import nullcontext
 from dataclasses import dataclass
 from typing import Any
@@ -12,7 +13,17 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from railopt.design.parallel import Shipped, WorkerLost, call, map_unordered_groups, resolve, shipping
+from railopt.design.parallel import (
+    Shipped,
+    WorkerLost,
+    call,
+    map_unordered_groups,
+    no_progress,
+    progress_of,
+    resolve,
+    shipping,
+    worker_threads,
+)
 from railopt.design.problem import MinimaxProblem
 from railopt.design.result import SolveResult, succeeded
 from railopt.design.runner import Runner
@@ -43,25 +54,43 @@ class _LostBatch:
     starts: tuple[Start, ...]
 
 
-MAX_BATCH = 8  # starts per task at most: a killed campaign redoes at most this many per worker
+MAX_BATCH = 16  # starts per task at most: a killed campaign redoes at most this many per worker
 COMMIT_TASKS = 32  # finished tasks committed in one store transaction at most (up to 32 × MAX_BATCH starts)
-TASKS_PER_WORKER = 8  # at least this many tasks per worker, so that uneven starts still balance
-TASK_SECONDS = 0.25  # a batch is made about this long: dask's per-task cost is a few ms of the worker's time
+TASK_SHARE = 2  # a task holds at most 1/TASK_SHARE of a worker's even share of the starts left
+TASK_SECONDS = 0.25  # a batch is made about this long: dask's per-task cost is a few ms of the driver's time
+TASKS_IN_FLIGHT = 2  # unfinished tasks per worker: one running, one waiting at the scheduler
+RECENT_STARTS = 64  # the batch is sized from the median time of at most this many latest starts
+WORKERS_REFRESH_S = 2.0  # s between two questions to the scheduler about its workers during a campaign
 
 
-def batch_size(n_todo: int, workers: int, start_seconds: float) -> int:
-    """Starts per dask task: enough for a task of ``TASK_SECONDS`` at ``start_seconds`` a start (the median
-    of the first starts), no more than keeps ``TASKS_PER_WORKER`` tasks per worker, 1 to ``MAX_BATCH``."""
+def batch_size(n_todo: int, workers: int, start_seconds: float | None) -> int:
+    """Starts in the next dask task (guided self-scheduling): one while no start has finished
+    (``start_seconds`` None), else enough for a task of ``TASK_SECONDS`` at ``start_seconds`` a start (the median
+    of the latest starts), no more than ``1/TASK_SHARE`` of a worker's even share of the ``n_todo`` starts
+    left — tasks shrink towards the end, so no worker is left with a long one while the others idle — 1 to
+    ``MAX_BATCH``."""
+    if start_seconds is None:
+        return 1
     enough = math.ceil(TASK_SECONDS / max(start_seconds, 1e-9))
-    balanced = n_todo // max(TASKS_PER_WORKER * workers, 1)
-    return int(max(1, min(MAX_BATCH, enough, balanced)))
+    share = math.ceil(n_todo / (TASK_SHARE * max(workers, 1)))
+    return int(max(1, min(MAX_BATCH, enough, share)))
 
 
-def _worker_threads(client: Runner) -> int:
-    try:
-        return max(sum(client.nthreads().values()), 1)
-    except Exception:  # noqa: BLE001  (a scheduler that does not answer: one start per task, as before)
-        return 1 << 30
+class _WorkerThreads:
+    """The threads of a cluster's workers, asked again at most every ``WORKERS_REFRESH_S`` seconds: workers that
+    join a cluster during a campaign get work (the window of unfinished tasks grows with them)."""
+
+    def __init__(self, client: Runner) -> None:
+        self.client = client
+        self.asked = -math.inf
+        self.threads = 1 << 30  # until a scheduler answers: every start in a task of its own, all submitted at once
+
+    def __call__(self) -> int:
+        now = time.monotonic()
+        if now - self.asked >= WORKERS_REFRESH_S:
+            self.asked = now
+            self.threads = worker_threads(self.client) or self.threads
+        return self.threads
 
 
 def _lost_batch(task: _StartBatch, lost: WorkerLost) -> _LostBatch:
@@ -122,17 +151,20 @@ def multistart(
     options : dict, optional
         Solver options (see :func:`railopt.design.solve.solve`).
     progress : callable(done, total), optional
-        Called after every finished start, once it is stored.
+        Called after every finished start, once it is stored (and first with the starts already stored); default:
+        the enclosing :func:`~railopt.design.parallel.reporting_progress` block's, if any, counting starts.
     cluster_xtol : float
         Distance (∞-norm in unit-cube coordinates) under which optima count as the same.
     retry_failed : bool
         Re-run the stored starts whose task killed every worker it ran on (status ``worker_lost``);
         by default a resume skips them, as it skips every finished start.
     batch : int, optional
-        Starts per dask task; default: one start on each worker first, then :func:`batch_size` from the
-        median time of those (tasks of about 0.25 s, at least eight per worker, 1 to 8 starts) — or, when there
-        are too few starts for a batch of two at any start time, one start per task from the outset (no wait for
-        the first starts to finish).
+        Starts per dask task; default: guided by :func:`batch_size` — one start a task until a start has
+        finished, then tasks of about 0.25 s at the median time of the latest starts, shrinking towards the end
+        of the campaign, 1 to 16 starts.  Each task is sized when it is submitted, a few ahead of the workers
+        (:data:`TASKS_IN_FLIGHT` per worker thread, the workers counted again every
+        :data:`WORKERS_REFRESH_S` s): no worker waits for the first starts to finish.  A fixed ``batch``
+        submits every task at once.
         Each start is solved, stored and reported exactly as alone: batching changes no number.
 
     A start whose task kills every dask worker that runs it (a crash in native code, out of memory)
@@ -165,6 +197,7 @@ def multistart(
         done_ids = store.finished_ids(retry_failed=bool(retry_failed))
         todo = [s for s in starts if s.start_id not in done_ids]
         total, done = len(starts), len(starts) - len(todo)
+        progress = progress_of(progress)  # else the enclosing reporting_progress block's, counting starts
         if progress is not None:
             progress(done, total)
         user_options = dict(options or {})
@@ -183,12 +216,15 @@ def multistart(
                 if progress is not None:
                     progress(done, total)
 
-        def run(tasks: list[_StartBatch], on_lost: Callable = _lost_batch) -> list[Start]:
+        def run(tasks: Iterable[_StartBatch], on_lost: Callable = _lost_batch,
+                window: Callable[[], int] | None = None) -> list[Start]:
             """Record every start of ``tasks``; return the starts of the tasks that were lost (``on_lost`` may
             instead give their rows, which are recorded).  The tasks that finished together are committed in one
-            transaction (group commit: never waiting for more results to fill it)."""
+            transaction (group commit: never waiting for more results to fill it).  With a ``window``, ``tasks``
+            is drawn lazily (see :func:`~railopt.design.parallel.map_unordered_groups`)."""
             lost: list[Start] = []
-            for group in map_unordered_groups(call, tasks, client=client, on_lost=on_lost, most=COMMIT_TASKS):
+            for group in map_unordered_groups(call, tasks, client=client, on_lost=on_lost, most=COMMIT_TASKS,
+                                              window=window, progress=no_progress):  # progress: in starts, above
                 rows: list[tuple[Start, SolveResult]] = []
                 for out in group:
                     if isinstance(out, _LostBatch):
@@ -201,19 +237,22 @@ def multistart(
         # the problem goes to the workers once for the campaign (nothing to ship when every start is stored)
         with shipping(client, problem) if todo else nullcontext(problem) as shipped:
 
-            def batches(starts: list[Start], size: int) -> list[_StartBatch]:
-                return [_StartBatch(shipped, tuple(starts[i:i + size]), method, user_options)
-                        for i in range(0, len(starts), size)]
+            def batches(starts: list[Start], size: int | None, workers: Callable[[], int] = lambda: 1
+                        ) -> Iterator[_StartBatch]:
+                """``starts`` in tasks of ``size`` starts, or (``None``) of :func:`batch_size` starts, each sized
+                when it is drawn, from the times of the starts recorded by then."""
+                i = 0
+                while i < len(starts):
+                    step = size or batch_size(len(starts) - i, workers(),
+                                              float(np.median(seconds[-RECENT_STARTS:])) if seconds else None)
+                    yield _StartBatch(shipped, tuple(starts[i:i + step]), method, user_options)
+                    i += step
 
-            if client is None or batch is not None:
+            if client is None or batch is not None:  # sizes known up front: every task submitted at once
                 suspects = run(batches(todo, int(batch or 1)))
-            elif batch_size(len(todo) - (workers := _worker_threads(client)), workers, 0.0) == 1:
-                suspects = run(batches(todo, 1))  # too few starts to batch, however short: no probe to wait for
-            else:  # one start per worker first: how long a start takes decides the batch
-                probe, rest = todo[:workers], todo[workers:]
-                suspects = run(batches(probe, 1))
-                size = batch_size(len(rest), workers, float(np.median(seconds)) if seconds else 0.0)
-                suspects += run(batches(rest, size))
+            else:  # a few tasks ahead of the workers, each sized when it is submitted: no wait for a probe
+                workers = _WorkerThreads(client)
+                suspects = run(batches(todo, None, workers), window=lambda: TASKS_IN_FLIGHT * workers())
             # A lost task's starts run again one at a time, each alone on the cluster: dask also holds a worker's
             # death against a task queued there, so only a start that kills two workers by itself is stored as lost.
             for start in suspects:
@@ -268,6 +307,7 @@ def distinct_optima(table: pd.DataFrame, problem: MinimaxProblem) -> pd.DataFram
 
 
 __all__ = [
-    "COMMIT_TASKS", "MAX_BATCH", "TASKS_PER_WORKER", "TASK_SECONDS", "batch_size", "distinct_optima",
+    "COMMIT_TASKS", "MAX_BATCH", "RECENT_STARTS", "TASKS_IN_FLIGHT", "TASK_SECONDS", "TASK_SHARE", "WORKERS_REFRESH_S",
+    "batch_size", "distinct_optima",
     "label_clusters", "multistart",
 ]

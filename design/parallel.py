@@ -496,6 +496,7 @@ def map_unordered_groups(
     on_lost: Callable[[Any, WorkerLost], Any] | None = None,
     progress: ProgressCallback | None = None,
     most: int = 32,
+    window: int | Callable[[], int] | None = None,
 ) -> Iterator[list[Any]]:
     """:func:`map_unordered`, the results given in lists: each list holds a result and those already finished
     when it was read, ``most`` at most; never waits for a result to fill a list.
@@ -506,53 +507,94 @@ def map_unordered_groups(
     errors as :func:`map_unordered`; ``progress`` is called after each finished task, before its list is given.
     When the scheduler is lost after some results of a list were read, the list is given first, then
     :class:`SchedulerError` is raised.
+
+    ``window`` (a whole number >= 1, or a callable giving one, asked again at every draw — a cluster whose
+    workers change; optional): ``items`` is then drawn lazily, at most ``window`` tasks unfinished at a time; the
+    next items are drawn when the consumer asks for the next list, so an item may be made from the results given so
+    far (:func:`~railopt.design.multistart.multistart` sizes its next batch from the starts' times).  A consumer
+    that takes longer over a list than a queued task takes to run leaves workers idle meanwhile.  Without a window
+    every item is submitted at once.  ``progress`` (or an enclosing :func:`reporting_progress`) needs a sized
+    ``items``: a caller drawing lazily reports in its own units and passes :func:`no_progress`.
     """
     if isinstance(most, bool) or not isinstance(most, numbers.Integral) or most < 1:
         raise ValueError(f"most: must be a whole number of results >= 1, got {most!r}")
-    items = list(items)
+    if window is not None and not callable(window):
+        _check_window(window)
+    if window is None:
+        items = list(items)
     report = progress_of(progress)
-    groups = _map(fn, items, client, retries, on_lost, int(most))
+    if report is no_progress:
+        report = None
+    if report is not None and not hasattr(items, "__len__"):
+        raise ValueError("progress: needs items of a known count (a list), not an iterator drawn lazily")
+    groups = _map(fn, items, client, retries, on_lost, int(most), window)
     if report is None:
         yield from groups
         return
-    report(0, len(items))
+    total = len(items)  # type: ignore[arg-type]
+    report(0, total)
     done = 0
     for group in groups:
         for _ in group:
             done += 1
-            report(done, len(items))
+            report(done, total)
         yield group
 
 
-def _map(fn: Callable[[Any], Any], items: list[Any], client: Runner | None, retries: int,
-         on_lost: Callable[[Any, WorkerLost], Any] | None, most: int) -> Iterator[list[Any]]:
+_DRAINED = object()  # the pump's last word: every future added to the stream so far has been handed on
+
+
+def _check_window(window: Any) -> int:
+    if isinstance(window, bool) or not isinstance(window, numbers.Integral) or window < 1:
+        raise ValueError(f"window: must be a whole number of tasks >= 1, got {window!r}")
+    return int(window)
+
+
+def _map(fn: Callable[[Any], Any], items: Iterable[Any], client: Runner | None, retries: int,
+         on_lost: Callable[[Any, WorkerLost], Any] | None, most: int,
+         window: int | Callable[[], int] | None) -> Iterator[list[Any]]:
     """:func:`map_unordered_groups` without progress."""
     task = _SingleThreaded(fn)
     if client is None:
         for item in items:
             yield [task(item)]
         return
-    if not items:
+    source = iter(items)
+
+    def limit() -> int:
+        return _check_window(window() if callable(window) else window)
+
+    first = list(source if window is None else itertools.islice(source, limit()))
+    if not first:
         return
     check_picklable(fn, getattr(fn, "__name__", "function"))
-    check_picklable(items[0])  # the tasks of one map share their problem and functions: the first tells
+    check_picklable(first[0])  # the tasks of one map share their problem and functions: the first tells
     from distributed import as_completed
 
     info = _CLIENTS.get(client) or _ClientInfo(_address(client), scheduler_timeout(), True)
     record = _track(client, info.timeout)
-    try:
-        futures = client.map(task, items, pure=False, retries=retries)
-    except Exception as exc:  # e.g. the connection is gone already
-        raise _lost(info, exc) from None
-    record._keys.update(f.key for f in futures)  # a lost worker's event names the tasks it was running
-    remaining = len(futures)
-    item_of = {f.key: it for f, it in zip(futures, items, strict=True)}
+    item_of: dict[Any, Any] = {}
     # only unfinished tasks are held: a finished one's future is dropped once its result is read, so the worker
     # frees the result (a long campaign's workers would otherwise keep every result to the end)
-    pending = {f.key: f for f in futures}
-    stream = as_completed(futures)
-    del futures
-    # as_completed blocks without a timeout: it runs in a thread, and this one watches the scheduler meanwhile
+    pending: dict[Any, Any] = {}
+
+    def submit(batch: list[Any]) -> list[Any]:
+        try:
+            futures = client.map(task, batch, pure=False, retries=retries)
+        except Exception as exc:  # e.g. the connection is gone already
+            raise _lost(info, exc) from None
+        record._keys.update(f.key for f in futures)  # a lost worker's event names the tasks it was running
+        for future, item in zip(futures, batch, strict=True):
+            item_of[future.key] = item
+            pending[future.key] = future
+        return futures
+
+    stream = as_completed(submit(first))
+    exhausted = window is None
+    del first
+    # as_completed blocks without a timeout: it runs in a thread, and this one watches the scheduler meanwhile.
+    # Its iteration ends whenever every future added so far was handed on; when futures are added after that
+    # (items drawn lazily), a new pump takes over the same stream.
     finished: queue.Queue = queue.Queue()
 
     def pump() -> None:
@@ -562,13 +604,28 @@ def _map(fn: Callable[[Any], Any], items: list[Any], client: Runner | None, retr
         except Exception as exc:  # noqa: BLE001  (the client broke down: reported below)
             finished.put(exc)
         finally:
-            finished.put(None)
+            finished.put(_DRAINED)
 
-    threading.Thread(target=pump, name="railopt-as-completed", daemon=True).start()
+    def start_pump() -> None:
+        threading.Thread(target=pump, name="railopt-as-completed", daemon=True).start()
+
+    start_pump()
+    pumping = True
+    handed = 0  # futures handed on by the pump since it was last (re)started
     no_workers_since: float | None = None
     unhealthy_since: float | None = None
     try:
-        while remaining:
+        while pending or not exhausted:
+            if not exhausted and len(pending) < (room := limit()):
+                more = list(itertools.islice(source, room - len(pending)))
+                exhausted = not more
+                if more:
+                    stream.update(submit(more))
+                    if not pumping:
+                        start_pump()
+                        pumping, handed = True, 0
+                if not pending:
+                    break
             try:
                 got = finished.get(timeout=_POLL)
             except queue.Empty:
@@ -592,14 +649,22 @@ def _map(fn: Callable[[Any], Any], items: list[Any], client: Runner | None, retr
                 else:
                     no_workers_since = None
                 continue
+            if got is _DRAINED:  # the pump saw an empty stream; futures added since are taken by a new one
+                pumping = False
+                if pending:
+                    if not handed:  # it stopped while the stream still held unfinished futures: broken down
+                        raise _lost(info, None)
+                    start_pump()
+                    pumping, handed = True, 0
+                continue
             no_workers_since = unhealthy_since = None
             group: list[Any] = []
             failure: BaseException | None = None
             while True:  # this result, then those already waiting (never waiting for more)
-                if got is None or isinstance(got, Exception):  # the stream of results ended early
-                    failure = _lost(info, got if isinstance(got, Exception) else None)
+                if isinstance(got, Exception):  # the stream of results broke down
+                    failure = _lost(info, got)
                     break
-                remaining -= 1
+                handed += 1
                 key = got.key
                 try:
                     result = _result(got, item_of.pop(key), info, on_lost)
@@ -609,11 +674,14 @@ def _map(fn: Callable[[Any], Any], items: list[Any], client: Runner | None, retr
                     break
                 del pending[key], got
                 group.append(result)
-                if not remaining or len(group) >= most:
+                if not pending or len(group) >= most:
                     break
                 try:
                     got = finished.get_nowait()
                 except queue.Empty:
+                    break
+                if got is _DRAINED:  # handled at the top of the loop, after this group
+                    finished.put(got)
                     break
             if group:
                 yield group
@@ -663,6 +731,16 @@ def _workers(client: Runner, timeout: float) -> dict | None:
         return dict(identity.get("workers", {}))
     except Exception:
         return None
+
+
+def worker_threads(client: Runner, timeout: float | None = None) -> int | None:
+    """Threads of all of ``client``'s workers, asked now and bounded in time (``timeout``, s; default
+    :func:`scheduler_timeout`); None when the scheduler does not answer or lists no threads."""
+    workers = _workers(client, scheduler_timeout(timeout))
+    if not workers:
+        return None
+    threads = sum(int(w.get("nthreads", 0) or 0) for w in workers.values() if isinstance(w, dict))
+    return threads or None
 
 
 def _lost(info: _ClientInfo, exc: BaseException | None) -> SchedulerError:
@@ -857,7 +935,14 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
                              # monitors
                              "distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "200ms",
                              "distributed.worker.memory.monitor-interval": "500ms",
-                             "distributed.admin.system-monitor.interval": "2s"}),
+                             "distributed.admin.system-monitor.interval": "2s",
+                             # dask starts its workers with MALLOC_TRIM_THRESHOLD_=65536 (memory handed back to the
+                             # OS early); setting it also switches off glibc's adaptive mmap threshold, so every
+                             # array over 128 kB is a fresh mmap, page-faulted in: the flagship's starts ran 5-8 %
+                             # slower in a worker than in a plain process.  None drops dask's value (glibc's
+                             # defaults); a MALLOC_TRIM_THRESHOLD_ in the user's own environment
+                             # still reaches the workers (they inherit this process's environment)
+                             "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}),
             LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                          # the scheduler's HTTP routes on a free local port, not 8787 (taken: a warning on stderr)
                          scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
@@ -897,5 +982,5 @@ __all__ = [
     "SCHEDULER_TIMEOUT_ENV", "ClusterRecord", "ProgressCallback", "SchedulerError", "WorkerLost", "call",
     "Shipped", "check_picklable", "cluster_record", "cluster_summary", "dask_client", "map_unordered",
     "map_unordered_groups", "no_progress", "progress_of", "reporting_progress", "resolve", "scheduler_timeout",
-    "shipping",
+    "shipping", "worker_threads",
 ]

@@ -18,10 +18,11 @@ class Runner(Protocol):
 
     - ``map(fn, items, pure=False, retries=n)`` submits ``fn`` over ``items`` and returns one future per item
       (futures with a ``key``, accepted by ``distributed.as_completed``);
-    - ``nthreads()`` maps each worker to its thread count (a batch size is chosen from the total);
+    - ``nthreads()`` maps each worker to its thread count;
     - ``status`` is ``"running"`` while the connection is healthy;
     - ``scheduler`` has an ``address`` and an ``identity`` coroutine, which ``sync(fn, ...)`` runs with
-      ``callback_timeout`` to list the workers (a lost scheduler is reported, never waited on forever).
+      ``callback_timeout`` to list the workers and their threads (a lost scheduler is reported, never waited on
+      forever; a campaign sizes its tasks and how many go ahead of the workers from those threads).
 
     Runners are hashable (open clients are remembered by identity).
     """

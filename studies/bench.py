@@ -10,7 +10,8 @@
 4. Multi-start throughput: starts/s serial vs a 2-worker dask LocalCluster, and the machine's own ceiling: the
    same starts in plain processes at once (no dask) against one alone.  The ceiling is measured first: below
    :data:`BUSY_CEILING` (other work on the machine) the parallel rows are marked as not results (their ratio left
-   empty, the measured one in the note).  Task dispatch of a short-start campaign of the flagship's problem at 1,
+   empty, the measured one in the note).  Dask's own floor at the short campaign's size: pure-CPU tasks of its
+   serial work, no railopt code.  Task dispatch of a short-start campaign of the flagship's problem at 1,
    2 and 4 local workers, the problem shipped once per campaign against the problem sent with every task.
 5. Critical speed of the locomotive (rigid track): eigen-solves and time of the bracketing + Brent
    search against a dense root-locus scan at the same resolution.
@@ -41,6 +42,7 @@ import pandas as pd
 from threadpoolctl import threadpool_limits
 
 from railopt.design import MinimaxProblem, dask_client, multistart
+from railopt.design.parallel import map_unordered
 from railopt.models import LinearSystem
 from railopt.models.stability import critical_speed
 from railopt.models.tmd import nishihara_asami
@@ -443,6 +445,41 @@ def _throughput(problem: MinimaxProblem, objective: str, workers: int, sizes: tu
     return rows
 
 
+def _spin(seconds: float) -> float:
+    """Burn ``seconds`` of this thread's CPU time in pure Python (no railopt code): a task of known work."""
+    end = time.thread_time() + seconds
+    while time.thread_time() < end:
+        pass
+    return seconds
+
+
+def _dask_floor_row(workers: int, work_s: float, n_starts: int, tasks: int = 16) -> dict:
+    """What dask itself leaves of ``workers`` on a campaign of ``work_s`` seconds of serial work (the ``n_starts``-start
+    TMD campaign's): ``tasks`` tasks of pure CPU (``_spin``, no railopt code) in the same LocalCluster set-up, against
+    the same spins in this process.
+    A short campaign's speed-up can only approach it: the gap is dask's cost per task and per map, on the same
+    cores as the workers."""
+    each = work_s / tasks
+    t = time.perf_counter()
+    for _ in range(tasks):
+        _spin(each)
+    serial = time.perf_counter() - t
+    with dask_client(workers=workers) as client:
+        list(map_unordered(_spin, [each] * 2 * workers, client=client))  # warm the workers (imports)
+        times = []
+        for _ in range(3):
+            t = time.perf_counter()
+            list(map_unordered(_spin, [each] * tasks, client=client))
+            times.append(time.perf_counter() - t)
+    ours = float(np.median(times))
+    return {"benchmark": f"dask's own floor on {work_s:.1f} s of work: {tasks} tasks of pure CPU (no railopt code)",
+            "ours_s": ours, "reference_s": serial, "reference": f"the same spins serially; ours = dask LocalCluster, "
+            f"{workers} workers", "ratio": ours / serial,
+            "note": f"{serial / ours:.2f}× speed-up: what dask's cost per task and per map leaves of {workers} "
+                    f"workers at this size (the {n_starts}-start TMD campaign's serial work, in about as many "
+                    "tasks)"}
+
+
 def _cab_throughput(workers: int, quick: bool) -> dict:
     """Starts per second of the flagship's exact cab problem, serial against a LocalCluster."""
     _, config, _ = load_study(STUDIES / "cab_lateral_minimax.toml")
@@ -636,7 +673,8 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
     ceiling_row = _ceiling_row(workers, n_starts)
     ceiling = 1.0 / ceiling_row["ratio"]
     problem = campaign_problem(config, setup, "exact")
-    parallel = [*_throughput(problem, "exact TMD objective", workers, (n_starts, 16 * n_starts)),
+    tmd = _throughput(problem, "exact TMD objective", workers, (n_starts, 16 * n_starts))
+    parallel = [*tmd, _dask_floor_row(workers, tmd[0]["reference_s"] * n_starts, n_starts),
                 _cab_throughput(workers, quick), *_dispatch_rows(quick, ceiling, workers)]
     rows.append(ceiling_row)
     rows += [busy_marked(row, ceiling, workers) for row in parallel]

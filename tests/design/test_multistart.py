@@ -175,13 +175,34 @@ def test_a_read_result_is_freed_on_the_worker(client):
 
 
 def test_batch_size_rule() -> None:
-    from railopt.design.multistart import MAX_BATCH, batch_size
+    """Guided self-scheduling: one start a task until a time is known, then about TASK_SECONDS a task, at most half
+    a worker's even share of the starts left, 1 to MAX_BATCH."""
+    from railopt.design.multistart import MAX_BATCH, TASK_SECONDS, TASK_SHARE, batch_size
 
-    assert batch_size(64, 2, 0.04) == 4  # 7 starts make 0.25 s, but 64 starts keep 8 tasks per worker at 4
+    assert (TASK_SECONDS, TASK_SHARE, MAX_BATCH) == (0.25, 2, 16)  # the numbers the cases below are worked out with
+    assert batch_size(10_000, 2, None) == 1  # no start finished yet: no time to size a batch from
     assert batch_size(10_000, 2, 0.04) == 7  # ceil(0.25 / 0.04)
     assert batch_size(10_000, 2, 1e-4) == MAX_BATCH
     assert batch_size(10_000, 2, 0.5) == 1  # long starts: one per task
+    assert batch_size(40, 2, 1e-4) == 10  # ceil(40 / (2 × 2)): shrinking with the starts left
+    assert batch_size(40, 5, 1e-4) == 4  # ceil(40 / (2 × 5))
     assert batch_size(3, 2, 1e-4) == 1
+    assert batch_size(1, 1, 0.0) == 1  # a zero time does not divide by zero
+
+
+def test_guided_batches_shrink_to_one_start_and_cover_every_start_once() -> None:
+    """The sizes batch_size gives over a whole campaign: each start in one task, tasks never growing once the time
+    is known, the last tasks one start each (no worker left holding a long task at the end)."""
+    from railopt.design.multistart import batch_size
+
+    for n, workers, seconds in [(64, 2, 0.015), (1024, 2, 0.015), (1000, 8, 1e-4), (33, 3, 0.1)]:
+        sizes, left = [], n
+        while left:
+            sizes.append(batch_size(left, workers, seconds))
+            left -= sizes[-1]
+        assert sum(sizes) == n and all(a >= b for a, b in zip(sizes, sizes[1:], strict=False))
+        assert sizes[-2 * workers:] == [1] * (2 * workers)  # the even share of the last starts is under one
+        assert sizes[0] == min(16, -(-n // (2 * workers)), -(-0.25 // seconds))
 
 
 def test_local_cluster_gives_the_serial_table_for_a_lapack_model(client):

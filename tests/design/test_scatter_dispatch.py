@@ -75,11 +75,11 @@ def test_a_campaign_ships_its_problem_once_and_stores_the_serial_rows(client, tm
     client.register_plugin, client.map = spy_register, spy_map
     try:
         with CampaignStore.create(tmp_path / "c.sqlite", "c", {}, ["a", "b"]) as store:
-            table = multistart(PROBLEM, 40, seed=6, client=client, store=store)  # probe, then batches
+            table = multistart(PROBLEM, 40, seed=6, client=client, store=store)  # one start a task, then batches
             stored = store.starts()
     finally:
         del client.register_plugin, client.map
-    assert len(registered) == 1  # one shipment for the campaign's maps (the probe and the batches)
+    assert len(registered) == 1  # one shipment for the campaign's maps (the first tasks and the refills)
     assert len(sizes) >= 3 and max(sizes) < 2_000  # every task carries a handle and its starts, not the problem
     assert _railopt_plugins(client) == ([], [])  # let go of on the scheduler and on every worker
     serial = multistart(PROBLEM, 40, seed=6)
@@ -91,14 +91,15 @@ def test_a_campaign_ships_its_problem_once_and_stores_the_serial_rows(client, tm
 
 
 @pytest.mark.timeout(180)
-@pytest.mark.parametrize("n_starts,maps", [(12, [[1] * 12]), (40, None)], ids=["too-few-to-batch", "probed"])
-def test_a_campaign_too_small_to_batch_is_one_map_without_a_probe(client, n_starts, maps) -> None:
-    """12 starts on 2 workers cannot make tasks of two starts while keeping 8 tasks per worker (batch_size's rule,
-    whatever a start costs): one map of one-start tasks, no wait for a probe map to finish first.  40 starts
-    can: a probe map of one start per worker, then the batches (at most 8 starts each)."""
-    from railopt.design.multistart import MAX_BATCH, batch_size
+@pytest.mark.parametrize("n_starts", [12, 40])
+def test_a_campaign_submits_a_few_tasks_ahead_each_sized_when_submitted(client, n_starts) -> None:
+    """No probe to wait for: the first map is TASKS_IN_FLIGHT one-start tasks per worker (no start's time is known
+    yet), and every later map refills the window as results come, with tasks sized by batch_size from the times
+    recorded by then — never more than the window unfinished, every start in exactly one task, the table a serial
+    run's."""
+    from railopt.design.multistart import MAX_BATCH, TASKS_IN_FLIGHT, batch_size
 
-    assert batch_size(n_starts - 2, 2, 0.0) == (1 if maps else 2)  # the rule, independently of the code path
+    window = TASKS_IN_FLIGHT * 2
     seen: list[list[int]] = []
     submit = client.map
 
@@ -112,12 +113,66 @@ def test_a_campaign_too_small_to_batch_is_one_map_without_a_probe(client, n_star
         table = multistart(PROBLEM, n_starts, seed=6, client=client)
     finally:
         del client.map
-    if maps:
-        assert seen == maps
-    else:
-        assert seen[0] == [1, 1] and len(seen) == 2 and 1 <= max(seen[1]) <= MAX_BATCH
-        assert sum(map(sum, seen)) == n_starts
+    assert seen[0] == [1] * window  # one start a task until a time is known: nothing waits on a probe map
+    assert len(seen) > 1 and all(len(sizes) <= window for sizes in seen[1:])  # the rest drawn as results came
+    assert sum(map(sum, seen)) == n_starts and max(max(sizes) for sizes in seen) <= MAX_BATCH
+    # the starts take well under a millisecond: once timed, tasks hold half a worker's share of what is left
+    assert seen[1][0] == batch_size(n_starts - window, 2, 1e-3) == -(-(n_starts - window) // 4) > 1
     pd.testing.assert_frame_equal(table[DETERMINISTIC], multistart(PROBLEM, n_starts, seed=6)[DETERMINISTIC])
+
+
+@pytest.mark.timeout(180)
+def test_a_fixed_batch_submits_every_task_at_once(client) -> None:
+    seen: list[list[int]] = []
+    submit = client.map
+
+    def spy_map(fn, items, **kwargs):
+        items = list(items)
+        seen.append([len(item.starts) for item in items])
+        return submit(fn, items, **kwargs)
+
+    client.map = spy_map
+    try:
+        table = multistart(PROBLEM, 40, seed=6, client=client, batch=3)
+    finally:
+        del client.map
+    assert seen == [[3] * 13 + [1]]
+    pd.testing.assert_frame_equal(table[DETERMINISTIC], multistart(PROBLEM, 40, seed=6)[DETERMINISTIC])
+
+
+@pytest.mark.timeout(180)
+def test_a_campaign_inside_a_progress_block_reports_its_starts(client) -> None:
+    """A trade-off sweep runs its campaigns inside ``reporting_progress``: a campaign drawing its tasks lazily
+    reports to that block in starts (0 first, then every start once), as it does to its own ``progress``."""
+    from railopt.design.parallel import reporting_progress
+
+    calls: list[tuple[int, int]] = []
+    with reporting_progress(lambda done, total: calls.append((done, total))):
+        table = multistart(PROBLEM, 24, seed=6, client=client)
+    assert calls == [(k, 24) for k in range(25)]
+    pd.testing.assert_frame_equal(table[DETERMINISTIC], multistart(PROBLEM, 24, seed=6)[DETERMINISTIC])
+
+
+def test_the_worker_count_is_asked_again_as_workers_join(monkeypatch) -> None:
+    """The window of a campaign follows the cluster: the threads are asked again every WORKERS_REFRESH_S s, an
+    unanswered question keeps the last count, and before any answer every task goes at once (1 << 30)."""
+    import importlib
+
+    ms = importlib.import_module("railopt.design.multistart")
+    answers = iter([None, 2, None, 6])
+    monkeypatch.setattr(ms, "worker_threads", lambda client: next(answers))
+    monkeypatch.setattr(ms, "WORKERS_REFRESH_S", 0.0)
+    threads = ms._WorkerThreads(object())
+    assert [threads() for _ in range(4)] == [1 << 30, 2, 2, 6]
+    monkeypatch.setattr(ms, "WORKERS_REFRESH_S", 3600.0)
+    assert threads() == 6  # not asked again within the hour (the iterator would be exhausted)
+
+
+@pytest.mark.timeout(60)
+def test_worker_threads_counts_the_threads_of_a_real_cluster(client) -> None:
+    from railopt.design.parallel import worker_threads
+
+    assert worker_threads(client) == 2 == sum(client.nthreads().values())
 
 
 @pytest.mark.timeout(180)

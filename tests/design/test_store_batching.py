@@ -14,6 +14,7 @@ import dataclasses
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from pathlib import Path
 
@@ -89,6 +90,87 @@ def test_on_dask_results_that_finished_together_come_in_one_group(client) -> Non
     with pytest.raises(ValueError, match="^most: "):
         next(map_unordered_groups(_square, range(3), most=0))
     assert sorted(map_unordered(_square, range(10), client=client)) == [i * i for i in range(10)]
+
+
+@pytest.mark.parametrize("window", [1, 3])
+def test_a_window_draws_items_lazily_and_never_holds_more_unfinished(client, window) -> None:
+    """With a window, an item is drawn only when the consumer asks for more, with at most ``window`` items drawn and
+    not yet given back; with a window of 1 the result stream runs dry before every draw, and a new pump takes it
+    over each time (no result lost, none twice)."""
+    given = [0]
+    ahead = []
+
+    def items():
+        for i in range(25):
+            ahead.append(i + 1 - given[0])  # drawn so far (this one included) minus results given back
+            yield i
+
+    pumps = []
+    start = threading.Thread.start
+
+    def counted(thread):
+        pumps.append(thread.name)
+        return start(thread)
+
+    threading.Thread.start = counted
+    try:
+        for group in map_unordered_groups(_nap_square, items(), client=client, window=window, most=4):
+            given[0] += len(group)
+            assert all(isinstance(v, int) for v in group)
+    finally:
+        threading.Thread.start = start
+    assert given[0] == 25 and max(ahead) <= window and ahead[:window] == list(range(1, window + 1))
+    if window == 1:  # every result left the stream empty before the next draw: a new pump each time
+        assert pumps.count("railopt-as-completed") > 1
+    # every result once, in any order, and serially the same lazy draw
+    assert sorted(v for g in map_unordered_groups(_square, items(), client=client, window=window) for v in g) \
+        == [i * i for i in range(25)]
+    assert [g for g in map_unordered_groups(_square, iter(range(4)), window=2)] == [[0], [1], [4], [9]]
+    assert list(map_unordered_groups(_square, iter(()), client=client, window=2)) == []
+
+
+class _EndsAtOnce:
+    """A result stream that ends at once, its tasks unfinished: what a client that broke down gives."""
+
+    def __init__(self, futures) -> None:
+        self.futures = list(futures)
+
+    def update(self, futures) -> None:
+        self.futures += list(futures)
+
+    def __iter__(self):
+        return iter(())
+
+
+@pytest.mark.timeout(60)  # without the check, a pump would be started again and again: a hang
+@pytest.mark.parametrize("window", [None, 2])
+def test_a_stream_that_ends_with_tasks_unfinished_is_a_lost_scheduler_not_a_hang(client, monkeypatch, window):
+    import distributed
+
+    from railopt.design.parallel import SchedulerError
+
+    monkeypatch.setattr(distributed, "as_completed", _EndsAtOnce)
+    with pytest.raises(SchedulerError):
+        list(map_unordered_groups(_nap_square, range(6), client=client, window=window))
+
+
+def test_a_window_may_follow_the_cluster_and_is_checked_each_time(client) -> None:
+    sizes = iter([1, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3])
+    got = [v for g in map_unordered_groups(_square, range(12), client=client, window=lambda: next(sizes)) for v in g]
+    assert sorted(got) == [i * i for i in range(12)]
+    with pytest.raises(ValueError, match="^window: "):
+        list(map_unordered_groups(_square, range(12), client=client, window=lambda: 0))
+
+
+def test_a_window_is_checked_and_progress_needs_a_count() -> None:
+    for bad in (0, -1, 1.5, True, "2"):
+        with pytest.raises(ValueError, match="^window: "):
+            next(map_unordered_groups(_square, range(3), window=bad))
+    with pytest.raises(ValueError, match="^progress: "):
+        next(map_unordered_groups(_square, iter(range(3)), window=2, progress=lambda d, t: None))
+    calls = []
+    groups = list(map_unordered_groups(_square, range(3), window=2, progress=lambda d, t: calls.append((d, t))))
+    assert groups == [[0], [1], [4]] and calls == [(0, 3), (1, 3), (2, 3), (3, 3)]
 
 
 def test_a_start_reported_is_a_start_stored_and_grouping_changes_no_number(client, tmp_path: Path) -> None:
