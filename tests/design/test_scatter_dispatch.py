@@ -90,6 +90,23 @@ def test_a_campaign_ships_its_problem_once_and_stores_the_serial_rows(client, tm
     assert table["value"].min() == pytest.approx(U_STAR, abs=1e-7)
 
 
+def _task_sizes(client, n_starts: int, **kwargs) -> tuple[pd.DataFrame, list[list[int]]]:
+    """A campaign's table and, for each ``client.map`` it made, the starts in each task of that map."""
+    seen: list[list[int]] = []
+    submit = client.map
+
+    def spy_map(fn, items, **map_kwargs):
+        items = list(items)
+        seen.append([len(item.starts) for item in items])
+        return submit(fn, items, **map_kwargs)
+
+    client.map = spy_map
+    try:
+        return multistart(PROBLEM, n_starts, seed=6, client=client, **kwargs), seen
+    finally:
+        del client.map
+
+
 @pytest.mark.timeout(180)
 @pytest.mark.parametrize("n_starts", [12, 40])
 def test_a_campaign_submits_a_few_tasks_ahead_each_sized_when_submitted(client, n_starts) -> None:
@@ -100,19 +117,7 @@ def test_a_campaign_submits_a_few_tasks_ahead_each_sized_when_submitted(client, 
     from railopt.design.multistart import MAX_BATCH, TASKS_IN_FLIGHT, batch_size
 
     window = TASKS_IN_FLIGHT * 2
-    seen: list[list[int]] = []
-    submit = client.map
-
-    def spy_map(fn, items, **kwargs):
-        items = list(items)
-        seen.append([len(item.starts) for item in items])
-        return submit(fn, items, **kwargs)
-
-    client.map = spy_map
-    try:
-        table = multistart(PROBLEM, n_starts, seed=6, client=client)
-    finally:
-        del client.map
+    table, seen = _task_sizes(client, n_starts)
     assert seen[0] == [1] * window  # one start a task until a time is known: nothing waits on a probe map
     assert len(seen) > 1 and all(len(sizes) <= window for sizes in seen[1:])  # the rest drawn as results came
     assert sum(map(sum, seen)) == n_starts and max(max(sizes) for sizes in seen) <= MAX_BATCH
@@ -123,19 +128,7 @@ def test_a_campaign_submits_a_few_tasks_ahead_each_sized_when_submitted(client, 
 
 @pytest.mark.timeout(180)
 def test_a_fixed_batch_submits_every_task_at_once(client) -> None:
-    seen: list[list[int]] = []
-    submit = client.map
-
-    def spy_map(fn, items, **kwargs):
-        items = list(items)
-        seen.append([len(item.starts) for item in items])
-        return submit(fn, items, **kwargs)
-
-    client.map = spy_map
-    try:
-        table = multistart(PROBLEM, 40, seed=6, client=client, batch=3)
-    finally:
-        del client.map
+    table, seen = _task_sizes(client, 40, batch=3)
     assert seen == [[3] * 13 + [1]]
     pd.testing.assert_frame_equal(table[DETERMINISTIC], multistart(PROBLEM, 40, seed=6)[DETERMINISTIC])
 
