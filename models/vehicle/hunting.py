@@ -22,8 +22,9 @@ generic machinery of :mod:`railopt.models.bifurcation` on it:
    :meth:`~railopt.models.bifurcation.BifurcationDiagram.nonlinear_critical_speed`.
 
 Amplitudes are the leading wheelset's lateral displacement relative to the track (m, half peak-to-peak).
-The cost is that of the Python right-hand side (0.4–1 ms a call on a profile table): a coach diagram takes
-minutes (``docs/nonlinear_vehicle.md``, ``railopt bench``).
+The right-hand side is one compiled call (:mod:`railopt.models.vehicle.wheelset_kernel`, 6–10 µs on a profile
+table, once compiled: about 10 s the first time, cached on disk): what remains is the integrator's own Python
+(``docs/nonlinear_vehicle.md``, ``railopt bench``).
 """
 
 from __future__ import annotations

@@ -35,6 +35,7 @@ from railopt.models.vehicle.wheelset_forces import (
     WheelsetForces,
     linear_model_forces,
 )
+from railopt.models.vehicle.wheelset_kernel import vehicle_jacobian, vehicle_rhs
 
 if TYPE_CHECKING:  # pragma: no cover
     from railopt.models.vehicle.vehicle import Vehicle
@@ -79,9 +80,10 @@ class NonlinearVehicle:
 
     def __post_init__(self) -> None:
         Minv = np.linalg.inv(self.M)
-        object.__setattr__(self, "_MK", Minv @ self.K)
-        object.__setattr__(self, "_MC", Minv @ self.C)
-        object.__setattr__(self, "_MB", Minv @ self.T_rows.T)
+        object.__setattr__(self, "_MK", np.ascontiguousarray(Minv @ self.K))
+        object.__setattr__(self, "_MC", np.ascontiguousarray(Minv @ self.C))
+        object.__setattr__(self, "_MB", np.ascontiguousarray(Minv @ self.T_rows.T))
+        object.__setattr__(self, "_T", np.ascontiguousarray(self.T_rows, dtype=float))
 
     @property
     def n_dof(self) -> int:
@@ -125,30 +127,48 @@ class NonlinearVehicle:
         return self.forces.evaluate(z[1], z[4], zd[1], zd[2], zd[4], zd[0], zd[3], speed)
 
     def rhs(self, t: float, x: np.ndarray, speed: float) -> np.ndarray:
-        """ẋ at time t (unused: autonomous) and forward speed ``speed`` (m/s), shape (2n,)."""
-        q, qd = self._split(x)
-        Q = self.contact_forces(x, speed).reshape(-1)
-        return np.concatenate([qd, self._MB @ Q - self._MK @ q - self._MC @ qd])
+        """ẋ at time t (unused: autonomous) and forward speed ``speed`` (m/s), shape (2n,): one compiled call
+        (:func:`~railopt.models.vehicle.wheelset_kernel.vehicle_rhs`).
+
+        Raises
+        ------
+        ValueError
+            x of the wrong shape, and the errors of :meth:`WheelsetForces.evaluate` (a wheel that lifts is a
+            :class:`~railopt.models.vehicle.wheelset_forces.WheelLift`)."""
+        x = np.asarray(x, dtype=float)
+        if x.shape != (2 * self.n_dof,):
+            self._split(x)  # the shape error
+        out = np.empty(x.size)
+        info = np.zeros(2)
+        status = vehicle_rhs(np.ascontiguousarray(x), float(speed), self._MK, self._MC, self._MB, self._T,
+                             *self.forces.kernel_arguments, out, info)
+        if status:
+            self.forces.raise_status(status, info)
+        return out
 
     def jacobian(self, x: np.ndarray, speed: float, step: float = JACOBIAN_STEP) -> np.ndarray:
         """∂ẋ/∂x (2n, 2n) by central differences, h_j = step · max(1, |x_j|) (error O(h²) plus round-off
         ≈ 1e-16 |f|/h: about 1e-11 relative at the default step at x = 0 for the bundled vehicles).
 
-        The 4n perturbed states go through the wheel/rail forces in one vectorised call (as 4n·K wheelsets), so
-        a Jacobian costs about one right-hand side plus small matrix products, not 4n of them."""
-        q, qd = self._split(x)
-        n = self.n_dof
-        k = len(self.wheelsets)
-        h = step * np.maximum(1.0, np.abs(np.concatenate([q, qd])))
-        E = np.diag(h)
-        X = np.concatenate([np.concatenate([q, qd])[None, :] + E, np.concatenate([q, qd])[None, :] - E])  # (4n, 2n)
-        m = X.shape[0]
-        z = (X[:, :n] @ self.T_rows.T).reshape(m, len(FORCE_ROWS), k).transpose(1, 0, 2).reshape(len(FORCE_ROWS), -1)
-        zd = (X[:, n:] @ self.T_rows.T).reshape(m, len(FORCE_ROWS), k).transpose(1, 0, 2).reshape(len(FORCE_ROWS), -1)
-        Q = self.forces.generalized_forces(z[1], z[4], zd[1], zd[2], zd[4], zd[0], zd[3], speed)
-        Q = Q.reshape(len(FORCE_ROWS), m, k).transpose(1, 0, 2).reshape(m, -1)  # (4n, 5K), rows as T_rows
-        F = np.concatenate([X[:, n:], Q @ self._MB.T - X[:, :n] @ self._MK.T - X[:, n:] @ self._MC.T], axis=1)
-        return ((F[: 2 * n] - F[2 * n:]) / (2.0 * h[:, None])).T
+        The 4n perturbed states go through the wheel/rail forces in one compiled call (as 4n·K wheelsets,
+        :func:`~railopt.models.vehicle.wheelset_kernel.vehicle_jacobian`), so a Jacobian costs about one
+        right-hand side of 4n·K wheelsets plus small matrix products.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`rhs`, for any of the perturbed states."""
+        x = np.asarray(x, dtype=float)
+        if x.shape != (2 * self.n_dof,):
+            self._split(x)  # the shape error
+        out = np.empty((x.size, x.size))
+        info = np.zeros(2)
+        status = vehicle_jacobian(np.ascontiguousarray(x), float(speed), float(step), self._MK, self._MC, self._MB,
+                                  self._T, *self.forces.kernel_arguments, out, info)
+        if status:
+            self.forces.raise_status(status, info)
+        return out
+
 
 def nonlinear_vehicle(vehicle: Vehicle, forces: WheelsetForces | None = None, block: str = "lateral",
                       track: str = "rigid") -> NonlinearVehicle:

@@ -45,6 +45,10 @@ Flange contact comes from the same geometry: near the flange the contact angle g
 the flange force.  A separate dead-band flange spring (:class:`FlangeSpring`) is only added when asked for
 (published benchmark models that use one).
 
+Implementation: these formulas are computed once, by the compiled kernels of :mod:`.wheelset_kernel` (numba):
+the geometry is a :class:`ConicalGeometry` or a :class:`TabulatedGeometry`, the law a :class:`LinearCreepLaw` or a
+:class:`SaturatedCreepLaw` — the kinds those kernels know (other objects are refused when the forces are built).
+
 Limits: the spin of the inclined contact takes δ in the track frame (the roll φ is left out of δ − σφ);
 rigid track only (a flexible, lumped track needs the track roll and the rail's lateral motion in the
 contact: not built, :func:`railopt.models.vehicle.nonlinear.nonlinear_vehicle` refuses it); small yaw
@@ -56,16 +60,16 @@ the saturated law — the curvature change along the profile is not followed.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from typing import Literal, Protocol, runtime_checkable
+from typing import Literal
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from railopt.models.bifurcation.integration import ModelLimit
-from railopt.models.contact.saturation import SPIN_MOMENT_CHOICES, she_force_ratio
+from railopt.models.contact.saturation import SPIN_MOMENT_CHOICES
 from railopt.models.validation import number
+from railopt.models.vehicle import wheelset_kernel as kernel
 from railopt.models.vehicle.wheelrail import Creep, WheelRail
 
 #: Row order of :meth:`WheelsetForces.generalized_forces`: the wheelset's coordinates that receive a force.
@@ -93,21 +97,6 @@ class ContactPoints:
     vertical_arm: np.ndarray
 
 
-@runtime_checkable
-class ContactGeometry(Protocol):
-    """What the forces need of a contact geometry: the nominal radius and the contact points at shifts y.
-
-    ``r0`` (m) is the rolling radius of the centred wheelset; ``points(y)`` takes y of shape (K,) (m, positive
-    to the left) and returns :class:`ContactPoints` of shape (2, K), raising ValueError outside its range.
-    """
-
-    r0: float
-
-    def points(self, y: np.ndarray) -> ContactPoints:
-        """Contact points of both wheels at the lateral shifts ``y`` (m, shape (K,)): radii, angles and arms."""
-        ...
-
-
 @dataclass(frozen=True)
 class ConicalGeometry:
     """The linear model's contact geometry (thesis (4.1)–(4.8)), exact in y (SI).
@@ -132,16 +121,20 @@ class ConicalGeometry:
         """The geometry of a vehicle's linear contact parameters (``vehicle.wheel_rail()``)."""
         return cls(wr.conicity, wr.r0, wr.e0, wr.theta0, wr.epsilon, wr.eta)
 
+    def parameters(self, params: np.ndarray) -> None:
+        """Write the cone into the kernels' parameter vector (:mod:`.wheelset_kernel`)."""
+        params[kernel.P_GEOMETRY] = 0.0
+        params[kernel.P_CONICITY:kernel.P_ETA + 1] = (self.conicity, self.r0, self.e0, self.theta0, self.epsilon,
+                                                      self.eta)
+
     def points(self, y: np.ndarray) -> ContactPoints:
         """The conical contact points at ``y`` (m, (K,)): exact in y, Δr = 2λy, tan δ = θ0 ± εy/e0."""
-        y = np.asarray(y, dtype=float)[None, :]
-        sigma = SIDES
-        return ContactPoints(
-            radius=self.r0 + sigma * self.conicity * y,
-            angle=np.arctan(self.theta0 + sigma * self.epsilon * y / self.e0),
-            lateral_arm=self.e0 - sigma * self.eta * y,
-            vertical_arm=np.full((2, y.shape[1]), self.r0),
-        )
+        y = _shifts(y)
+        params = np.zeros(kernel.N_PARAMS)
+        self.parameters(params)
+        out = np.empty((4, 2, y.size))
+        kernel.conical_points(y, params, out)
+        return ContactPoints(*out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,10 +171,16 @@ class TabulatedGeometry:
     def __post_init__(self) -> None:
         if self.kind not in ("linear", "pchip"):
             raise ValueError(f"kind: 'linear' or 'pchip', got {self.kind!r}")
+        y = np.ascontiguousarray(self.y, dtype=float)
         stacked = np.concatenate([self.radius, self.angle, self.lateral_arm, self.vertical_arm])  # (8, n)
-        object.__setattr__(self, "_stacked", stacked)
-        if self.kind == "pchip":
-            object.__setattr__(self, "_pchip", PchipInterpolator(self.y, stacked, axis=1, extrapolate=False))
+        if self.kind == "pchip":  # scipy's coefficients (4, n - 1, 8); the kernel evaluates the cubics
+            coef = PchipInterpolator(y, stacked, axis=1).c
+        else:  # the straight lines as cubics with zero cubic and quadratic terms
+            coef = np.zeros((4, y.size - 1, 8))
+            coef[2] = (np.diff(stacked, axis=1) / np.diff(y)).T
+            coef[3] = stacked[:, :-1].T
+        object.__setattr__(self, "_breaks", y)
+        object.__setattr__(self, "_coef", np.ascontiguousarray(coef, dtype=float))
 
     @classmethod
     def from_table(cls, table: object, source: str = "contact table", kind: str = "linear") -> TabulatedGeometry:
@@ -202,37 +201,38 @@ class TabulatedGeometry:
         return cls(y=y, radius=r, angle=delta, lateral_arm=a, vertical_arm=h, r0=float(table.r0), source=source,
                    kind=kind)
 
+    def parameters(self, params: np.ndarray) -> None:
+        """Mark a table in the kernels' parameter vector (its breakpoints and cubics travel as :meth:`table`)."""
+        params[kernel.P_GEOMETRY] = 1.0
+
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
+        """Breakpoints (n,) and cubic coefficients (4, n − 1, 8) of :func:`.wheelset_kernel.table_points`."""
+        return self._breaks, self._coef
+
+    def outside(self, y: float) -> ValueError:
+        """The error for a shift ``y`` (m) outside the table."""
+        return ValueError(f"{self.source}: lateral shift {y:.6g} m outside the table [{self.y[0]:.6g}, "
+                          f"{self.y[-1]:.6g}] m (beyond the flange range)")
+
     def points(self, y: np.ndarray) -> ContactPoints:
         """The table's contact points interpolated at ``y`` (m, (K,)); ValueError naming the table outside it."""
-        y = np.asarray(y, dtype=float)
+        y = _shifts(y)
         if y.size and (np.min(y) < self.y[0] or np.max(y) > self.y[-1]):
-            raise ValueError(f"{self.source}: lateral shift {float(np.max(np.abs(y))):.6g} m outside the table "
-                             f"[{self.y[0]:.6g}, {self.y[-1]:.6g}] m (beyond the flange range)")
-        if self.kind == "pchip":
-            v = self._pchip(y)
-        else:  # the interval of every y once, then the same weights for every field
-            i = np.clip(np.searchsorted(self.y, y, side="right") - 1, 0, self.y.size - 2)
-            w = (y - self.y[i]) / (self.y[i + 1] - self.y[i])
-            v = self._stacked[:, i] * (1.0 - w) + self._stacked[:, i + 1] * w
-        return ContactPoints(v[0:2], v[2:4], v[4:6], v[6:8])
+            raise self.outside(float(np.max(np.abs(y))))
+        out = np.empty((4, 2, y.size))
+        kernel.table_points(y, self._breaks, self._coef, out)
+        return ContactPoints(*out)
+
+
+#: The contact geometries the compiled forces know: the cone of the linear model, or a rigid contact table.
+ContactGeometry = ConicalGeometry | TabulatedGeometry
+
+
+def _shifts(y: object) -> np.ndarray:
+    return np.ascontiguousarray(np.atleast_1d(np.asarray(y, dtype=float)).reshape(-1))
 
 
 # ---------------------------------------------------------------------------------------------------- creep laws
-@runtime_checkable
-class CreepLaw(Protocol):
-    """A creep law: forces of contacts from their creepages and normal loads.
-
-    ``__call__(creep, xi_x, xi_y, xi_sp, N, N0) -> (Fx, Fy, Mz)``: ``creep`` the wheel's linear coefficients
-    at the nominal load N0 (N) in the convention of :mod:`.wheelrail`; arrays broadcast; forces in N, moment
-    in N·m.  ``load_dependent`` says whether the forces depend on N (else the normal loads need one pass).
-    """
-
-    load_dependent: bool
-
-    def __call__(self, creep: Creep, xi_x: np.ndarray, xi_y: np.ndarray, xi_sp: np.ndarray, N: np.ndarray,
-                 N0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
-
-
 @dataclass(frozen=True)
 class LinearCreepLaw:
     """Kalker's linear law (4.9) with the vehicle's constant coefficients (no load dependence): the linear
@@ -240,8 +240,13 @@ class LinearCreepLaw:
 
     load_dependent: bool = field(default=False, init=False)
 
+    def parameters(self, params: np.ndarray) -> None:
+        """Write the law into the kernels' parameter vector (:mod:`.wheelset_kernel`)."""
+        params[kernel.P_LAW] = 0.0
+
     def __call__(self, creep: Creep, xi_x, xi_y, xi_sp, N, N0):
-        return (-creep.f11 * xi_x, -creep.f22 * xi_y + creep.f23 * xi_sp, -creep.f23 * xi_y - creep.f33 * xi_sp)
+        """Forces (Fx, Fy, Mz) (N, N·m) at creepages and normal loads N (arrays broadcast; N0 unused)."""
+        return _creep_forces(self, creep, xi_x, xi_y, xi_sp, N, N0)
 
 
 @dataclass(frozen=True)
@@ -273,24 +278,37 @@ class SaturatedCreepLaw:
         if self.spin_moment not in SPIN_MOMENT_CHOICES:
             raise ValueError(f"spin_moment: one of {SPIN_MOMENT_CHOICES}, got {self.spin_moment!r}")
 
+    def parameters(self, params: np.ndarray) -> None:
+        """Write the law into the kernels' parameter vector (:mod:`.wheelset_kernel`)."""
+        params[kernel.P_LAW] = 1.0
+        params[kernel.P_MU] = self.mu
+        params[kernel.P_SPIN_SCALED] = 1.0 if self.spin_moment == "scaled" else 0.0
+        params[kernel.P_LOAD_SCALING] = 1.0 if self.load_scaling else 0.0
+
     def __call__(self, creep: Creep, xi_x, xi_y, xi_sp, N, N0):
+        """Forces (Fx, Fy, Mz) (N, N·m) at creepages and normal loads N > 0 (arrays broadcast), nominal load N0.
+
+        Raises :class:`WheelLift` for a load N ≤ 0."""
         N = np.asarray(N, dtype=float)
         if np.any(N <= 0.0):
             raise WheelLift(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0): the wheelset "
                              "derails in this model; the rigid contact no longer applies")
-        k = N / N0 if self.load_scaling else np.ones_like(N)
-        c = np.cbrt(k)
-        s2, s3, s4 = c * c, k, k * c
-        # linear forces (4.9) with the load-scaled coefficients, then the resultant's factor ε = F/F'
-        tx = -creep.f11 * s2 * xi_x
-        ty = -creep.f22 * s2 * xi_y + creep.f23 * s3 * xi_sp
-        mz = -creep.f23 * s3 * xi_y - creep.f33 * s4 * xi_sp
-        F = np.hypot(tx, ty)
-        r = F / (self.mu * N)
-        eps = np.where(r > 0.0, she_force_ratio(r) / np.where(r > 0.0, r, 1.0), 1.0)
-        if self.spin_moment == "scaled":
-            mz = eps * mz
-        return eps * tx, eps * ty, mz
+        return _creep_forces(self, creep, xi_x, xi_y, xi_sp, N, N0)
+
+
+#: The creep laws the compiled forces know: Kalker's linear law or the Shen–Hedrick–Elkins saturation.
+CreepLaw = LinearCreepLaw | SaturatedCreepLaw
+
+
+def _creep_forces(law: CreepLaw, creep: Creep, xi_x, xi_y, xi_sp, N, N0) -> tuple[np.ndarray, ...]:
+    params = np.zeros(kernel.N_PARAMS)
+    params[kernel.P_F11:kernel.P_F33 + 1] = (creep.f11, creep.f22, creep.f23, creep.f33)
+    law.parameters(params)
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (xi_x, xi_y, xi_sp, N)))
+    flat = [np.ascontiguousarray(a).reshape(-1) for a in arrays]
+    out = np.empty((3, flat[0].size))
+    kernel.creep_forces(params, *flat, float(N0), out)
+    return tuple(out[i].reshape(arrays[0].shape) for i in range(3))
 
 
 # ---------------------------------------------------------------------------------------------------- flange spring
@@ -384,18 +402,76 @@ class WheelsetForces:
     flange: FlangeSpring | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.geometry, ContactGeometry):
-            raise ValueError("geometry: needs r0 and points(y) (a ConicalGeometry or TabulatedGeometry)")
+        if not isinstance(self.geometry, ConicalGeometry | TabulatedGeometry):
+            raise ValueError("geometry: a ConicalGeometry or TabulatedGeometry (the geometries the compiled forces "
+                             f"know), got {type(self.geometry).__name__}")
         if not isinstance(self.creep, Creep):
             raise ValueError("creep: a wheelrail.Creep with the per-wheel linear coefficients")
         object.__setattr__(self, "axle_load", number("axle_load", self.axle_load, positive=True))
         if self.plane not in ("contact", "track"):
             raise ValueError(f"plane: 'contact' or 'track', got {self.plane!r}")
-        if not isinstance(self.creep_law, CreepLaw):
-            raise ValueError("creep_law: a LinearCreepLaw, SaturatedCreepLaw or another CreepLaw")
+        if not isinstance(self.creep_law, LinearCreepLaw | SaturatedCreepLaw):
+            raise ValueError("creep_law: a LinearCreepLaw or SaturatedCreepLaw (the laws the compiled forces know), "
+                             f"got {type(self.creep_law).__name__}")
+        params = np.zeros(kernel.N_PARAMS)
+        params[kernel.P_R0] = self.geometry.r0
+        params[kernel.P_W] = self.axle_load
+        params[kernel.P_F11:kernel.P_F33 + 1] = (self.creep.f11, self.creep.f22, self.creep.f23, self.creep.f33)
+        self.creep_law.parameters(params)
+        params[kernel.P_PLANE] = 0.0 if self.plane == "contact" else 1.0
+        if self.flange is not None:
+            params[kernel.P_FLANGE_K] = self.flange.stiffness
+            params[kernel.P_FLANGE_D] = self.flange.clearance
+        self.geometry.parameters(params)
+        if isinstance(self.geometry, TabulatedGeometry):
+            breaks, coef = self.geometry.table()
+        else:  # a cone reads no table: placeholders of the kernels' one signature
+            breaks, coef = np.zeros(2), np.zeros((4, 1, 8))
+        object.__setattr__(self, "_kernel_args", (params, breaks, coef))
+
+    @property
+    def kernel_arguments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(params, breakpoints, coefficients) of :func:`.wheelset_kernel.wheelset_forces` for these forces."""
+        return self._kernel_args
+
+    def raise_status(self, status: int, info: np.ndarray) -> None:
+        """Raise the error of a kernel status (:mod:`.wheelset_kernel`); nothing for ``OK``.
+
+        Raises
+        ------
+        ValueError
+            A non-positive speed; a shift outside the table (naming it); normal loads that do not converge.
+        WheelLift
+            A wheel's normal load reached zero (a ValueError too).
+        """
+        if status == kernel.OK:
+            return
+        if status == kernel.BAD_SPEED:
+            raise ValueError(f"speed: forward speed must be a positive finite number of m/s, got {info[0]!r}")
+        if status == kernel.OUTSIDE_TABLE:
+            raise self.geometry.outside(float(info[0]))
+        if status == kernel.WHEEL_LIFT:
+            raise WheelLift(f"normal load: a wheel lifts (N = {info[0]:.4g} N <= 0) at y = {info[1]:.6g} m: the "
+                            "rigid contact no longer applies (derailment)")
+        raise ValueError(f"normal load: the normal loads and creep forces did not converge in {kernel.MAX_PASSES} "
+                         "passes")
+
+    def _run(self, y, yaw, dy, droll, dyaw, du, dpitch, speed: float) -> tuple[np.ndarray, np.ndarray]:
+        try:
+            args = [np.ascontiguousarray(a) for a in np.broadcast_arrays(
+                *(_shifts(a) for a in (y, yaw, dy, droll, dyaw, du, dpitch)))]
+        except ValueError:
+            raise ValueError("y, yaw, dy, droll, dyaw, du, dpitch: one value per wheelset each (or one for all), "
+                             "sizes differ") from None
+        k = args[0].size
+        state = np.empty((kernel.N_STATE, 2, k))
+        gen = np.empty((len(FORCE_ROWS), k))
+        info = np.zeros(2)
+        self.raise_status(kernel.wheelset_forces(*args, float(speed), *self._kernel_args, state, gen, info), info)
+        return state, gen
 
     def evaluate(self, y, yaw, dy, droll, dyaw, du, dpitch, speed: float) -> WheelsetContactState:
-        """Contact state and generalised forces of K wheelsets.
+        """Contact state and generalised forces of K wheelsets (:func:`.wheelset_kernel.wheelset_forces`).
 
         Parameters
         ----------
@@ -409,80 +485,19 @@ class WheelsetForces:
         Raises
         ------
         ValueError
-            A non-positive speed; y outside a tabulated geometry; a wheel that lifts (N ≤ 0); normal loads
-            that do not converge.
+            A non-positive speed; inputs of different sizes; y outside a tabulated geometry; a wheel that lifts
+            (N ≤ 0, :class:`WheelLift`); normal loads that do not converge.
         """
-        if not (speed > 0.0 and math.isfinite(speed)):
-            raise ValueError(f"speed: forward speed must be a positive finite number of m/s, got {speed!r}")
-        y, yaw, dy, droll, dyaw, du, dpitch = (np.atleast_1d(np.asarray(a, dtype=float))
-                                               for a in (y, yaw, dy, droll, dyaw, du, dpitch))
-        S = float(speed)
-        r0 = self.geometry.r0
-        W = self.axle_load
-        g = self.geometry.points(y)
-        sigma = SIDES
-        r, a, h = g.radius, g.lateral_arm, g.vertical_arm
-        s, c = np.sin(g.angle), np.cos(g.angle)
-        sg, cg = np.sin(yaw)[None, :], np.cos(yaw)[None, :]
-        px, py = -sigma * a * sg, sigma * a * cg  # arms, rotated with the yaw; pz = −h
-        # creepages
-        xi_x = (du[None, :] - sigma * a * dyaw[None, :] - r * dpitch[None, :]) / S + (r0 - r) / r0
-        nu = (dy[None, :] + h * droll[None, :]) / S - yaw[None, :]
-        if self.plane == "contact":
-            xi_y = nu / c
-            xi_sp = dyaw[None, :] * c / S - sigma * s / r0
-            ty, tz = c, sigma * s  # lateral tangent
-            my, mz = -sigma * s, c  # normal (spin-moment axis)
-        else:
-            xi_y = np.broadcast_to(nu, r.shape)
-            xi_sp = np.broadcast_to(dyaw[None, :] / S, r.shape)
-            ty, tz = np.ones_like(r), np.zeros_like(r)
-            my, mz = np.zeros_like(r), np.ones_like(r)
-        ny, nz = -sigma * s, c
-        # normal loads from the vertical and roll balance, iterated with a load-dependent creep law
-        N0 = 0.5 * W
-        # roll moment of a unit normal load: (p × n)_x = py nz + h ny
-        arm_n = py * nz + h * ny
-        N = np.full(r.shape, N0) / c
-        for _ in range(50):
-            Fx, Fy, Mz = self.creep_law(self.creep, xi_x, xi_y, xi_sp, N, N0)
-            Fy_y, Fy_z = Fy * ty, Fy * tz
-            rhs_v = W - np.sum(Fy_z, axis=0)
-            rhs_r = -np.sum(py * Fy_z + h * Fy_y, axis=0)
-            det = nz[0] * arm_n[1] - nz[1] * arm_n[0]
-            N_new = np.stack([(rhs_v * arm_n[1] - nz[1] * rhs_r) / det, (nz[0] * rhs_r - arm_n[0] * rhs_v) / det])
-            change = float(np.max(np.abs(N_new - N)))
-            N = N_new
-            if np.any(N <= 0.0):
-                i = int(np.argmin(np.min(N, axis=0)))
-                raise WheelLift(f"normal load: a wheel lifts (N = {float(np.min(N)):.4g} N <= 0) at y = "
-                                 f"{y[i]:.6g} m: the rigid contact no longer applies (derailment)")
-            if not self.creep_law.load_dependent:
-                break
-            if change <= 1e-10 * W:  # N balances these forces exactly; they are those of N within 1e-10 W
-                break
-        else:
-            raise ValueError("normal load: the normal loads and creep forces did not converge in 50 passes")
-        # forces on the wheel in track axes
-        Fy_y, Fy_z = Fy * ty, Fy * tz
-        Ftot_x = Fx
-        Ftot_y = Fy_y + N * ny
-        Ftot_z = Fy_z + N * nz
-        pz = -h
-        gen = np.empty((len(FORCE_ROWS), y.size))
-        gen[0] = np.sum(Ftot_x, axis=0)
-        gen[1] = np.sum(Ftot_y, axis=0)
-        gen[2] = np.sum(py * Ftot_z - pz * Ftot_y, axis=0)
-        gen[3] = np.sum(pz * Ftot_x - px * Ftot_z + Mz * my, axis=0)
-        gen[4] = np.sum(px * Ftot_y - py * Ftot_x + Mz * mz, axis=0)
-        if self.flange is not None:
-            gen[1] += self.flange.force(y)
-        return WheelsetContactState(points=g, xi_x=xi_x, xi_y=np.asarray(xi_y), xi_sp=np.asarray(xi_sp), Fx=Fx,
-                                    Fy=Fy, Mz=Mz, N=N, Q=Ftot_z, Y=Ftot_y, forces=gen)
+        s, gen = self._run(y, yaw, dy, droll, dyaw, du, dpitch, speed)
+        k = kernel
+        return WheelsetContactState(
+            points=ContactPoints(s[k.S_RADIUS], s[k.S_ANGLE], s[k.S_LATERAL_ARM], s[k.S_VERTICAL_ARM]),
+            xi_x=s[k.S_XI_X], xi_y=s[k.S_XI_Y], xi_sp=s[k.S_XI_SP], Fx=s[k.S_FX], Fy=s[k.S_FY], Mz=s[k.S_MZ],
+            N=s[k.S_N], Q=s[k.S_Q], Y=s[k.S_Y], forces=gen)
 
     def generalized_forces(self, y, yaw, dy, droll, dyaw, du, dpitch, speed: float) -> np.ndarray:
         """Generalised forces (5, K) on the rows :data:`FORCE_ROWS` (N, N·m); arguments as :meth:`evaluate`."""
-        return self.evaluate(y, yaw, dy, droll, dyaw, du, dpitch, speed).forces
+        return self._run(y, yaw, dy, droll, dyaw, du, dpitch, speed)[1]
 
 
 def linear_model_forces(wr: WheelRail) -> WheelsetForces:

@@ -72,3 +72,44 @@ def test_the_study_context_warms_the_kernels_before_any_cluster_starts(monkeypat
     with kind.dask_context(context):
         pass
     assert events == (["warm", "cluster"] if warmed else ["cluster"])
+
+
+NONLINEAR_PROBE = """
+import json, sys
+from railopt.models.vehicle import wheelset_kernel
+if sys.argv[1] == "driver":
+    from railopt.studies.kernel_warmup import warm_nonlinear_kernels
+    warm_nonlinear_kernels(show_progress=False)
+else:  # what a nonlinear_hunting check's task runs: the profile vehicle's rhs, Jacobian and contact state
+    import numpy as np
+    from railopt.models.vehicle import load_vehicle
+    from railopt.models.vehicle.hunting import profile_vehicle
+    model = profile_vehicle(load_vehicle("tests/models/vehicle/data/wheelset-s1002.toml"))
+    x = np.zeros(2 * model.n_dof)
+    x[0] = 1e-3
+    model.rhs(0.0, x, 40.0), model.jacobian(x, 40.0), model.contact_state(x, 40.0)
+used = {name: (d.stats.cache_hits, d.stats.cache_misses) for name, d in vars(wheelset_kernel).items()
+        if hasattr(d, "stats") and (d.stats.cache_hits or d.stats.cache_misses)}
+print(json.dumps({name: [sum(h.values()), sum(m.values())] for name, (h, m) in used.items()}))
+"""
+
+
+@pytest.mark.slow
+def test_after_the_nonlinear_warm_up_a_check_loads_the_wheel_rail_kernels_from_the_cache(tmp_path):
+    """A campaign with a ``nonlinear_hunting`` check warms the wheel/rail kernels in the driver
+    (``warm_nonlinear_kernels``): the check's work in a fresh process then compiles none of them."""
+    def probe(role: str, cache: Path = tmp_path) -> dict[str, list[int]]:
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+        done = subprocess.run([sys.executable, "-c", NONLINEAR_PROBE, role], env=env, capture_output=True,
+                              text=True, timeout=300, cwd=ROOT)
+        assert done.returncode == 0, done.stderr
+        return json.loads(done.stdout.strip().splitlines()[-1])
+
+    unwarmed = probe("worker", tmp_path / "elsewhere")  # the probe sees a compile where there is one
+    assert unwarmed["vehicle_rhs"][1] >= 1 and unwarmed["vehicle_jacobian"][1] >= 1
+    cold = probe("driver")
+    assert {"vehicle_rhs", "vehicle_jacobian", "wheelset_forces"} <= set(cold)
+    assert all(misses >= 1 for _, misses in cold.values())
+    worker = probe("worker")
+    assert {"vehicle_rhs", "vehicle_jacobian", "wheelset_forces"} <= set(worker)
+    assert all(hits >= 1 and misses == 0 for hits, misses in worker.values()), worker

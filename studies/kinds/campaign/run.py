@@ -76,6 +76,10 @@ def compute(config: CampaignStudyConfig, context: StudyContext) -> CampaignResul
     optima: dict[tuple[str, str, str, str], pd.DataFrame] = {}
     rows = []
     flags: dict[tuple[str, str, str, str], list[str]] = {}
+    if context.workers != 0 and "nonlinear_hunting" in cfg.design.checks:  # its checks run on the workers
+        from railopt.studies.kernel_warmup import warm_nonlinear_kernels
+
+        warm_nonlinear_kernels(context.show_progress)
     with dask_context(context) as client:
         for key in keys:
             tables[key], optima[key], flags[key] = _campaign(cfg, setups[key[0]], key, context, client)
