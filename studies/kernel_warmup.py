@@ -54,7 +54,7 @@ def warm_nonlinear_kernels(show_progress: bool = True) -> float:
     """Compile (or load) the nonlinear wheel/rail kernels (:mod:`railopt.models.vehicle.wheelset_kernel`) in the
     driver — the right-hand side, its Jacobian, the forces' state and a table's geometry of the bundled single
     wheelset — before the workers of a campaign with a ``nonlinear_hunting`` check start; returns the seconds it
-    took (about 10 s cold, 0.3 s from the cache).  Prints one line to stderr when it took over 2 s and
+    took (10–15 s cold, 0.3 s from the cache).  Prints one line to stderr when it took over 2 s and
     ``show_progress``."""
     from railopt.models.contact.rigid_contact import ContactTable
     from railopt.models.vehicle import load_vehicle

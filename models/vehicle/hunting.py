@@ -23,7 +23,7 @@ generic machinery of :mod:`railopt.models.bifurcation` on it:
 
 Amplitudes are the leading wheelset's lateral displacement relative to the track (m, half peak-to-peak).
 The right-hand side is one compiled call (:mod:`railopt.models.vehicle.wheelset_kernel`, 6–10 µs on a profile
-table, once compiled: about 10 s the first time, cached on disk): what remains is the integrator's own Python
+table, once compiled: 10–15 s the first time, cached on disk): what remains is the integrator's own Python
 (``docs/nonlinear_vehicle.md``, ``railopt bench``).
 """
 

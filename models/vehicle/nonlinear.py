@@ -27,12 +27,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from railopt.models.kernels import c_array
 from railopt.models.vehicle.assembly import assemble
 from railopt.models.vehicle.geometry import LATERAL_DOFS, VERTICAL_DOFS, coordinate, split
 from railopt.models.vehicle.wheelset_forces import (
     FORCE_ROWS,
     WheelsetContactState,
     WheelsetForces,
+    forward_speed,
     linear_model_forces,
 )
 from railopt.models.vehicle.wheelset_kernel import vehicle_jacobian, vehicle_rhs
@@ -80,10 +82,10 @@ class NonlinearVehicle:
 
     def __post_init__(self) -> None:
         Minv = np.linalg.inv(self.M)
-        object.__setattr__(self, "_MK", np.ascontiguousarray(Minv @ self.K))
-        object.__setattr__(self, "_MC", np.ascontiguousarray(Minv @ self.C))
-        object.__setattr__(self, "_MB", np.ascontiguousarray(Minv @ self.T_rows.T))
-        object.__setattr__(self, "_T", np.ascontiguousarray(self.T_rows, dtype=float))
+        object.__setattr__(self, "_MK", c_array(Minv @ self.K))
+        object.__setattr__(self, "_MC", c_array(Minv @ self.C))
+        object.__setattr__(self, "_MB", c_array(Minv @ self.T_rows.T))
+        object.__setattr__(self, "_T", c_array(self.T_rows))
 
     @property
     def n_dof(self) -> int:
@@ -140,7 +142,7 @@ class NonlinearVehicle:
             self._split(x)  # the shape error
         out = np.empty(x.size)
         info = np.zeros(2)
-        status = vehicle_rhs(np.ascontiguousarray(x), float(speed), self._MK, self._MC, self._MB, self._T,
+        status = vehicle_rhs(c_array(x), forward_speed(speed), self._MK, self._MC, self._MB, self._T,
                              *self.forces.kernel_arguments, out, info)
         if status:
             self.forces.raise_status(status, info)
@@ -163,7 +165,7 @@ class NonlinearVehicle:
             self._split(x)  # the shape error
         out = np.empty((x.size, x.size))
         info = np.zeros(2)
-        status = vehicle_jacobian(np.ascontiguousarray(x), float(speed), float(step), self._MK, self._MC, self._MB,
+        status = vehicle_jacobian(c_array(x), forward_speed(speed), float(step), self._MK, self._MC, self._MB,
                                   self._T, *self.forces.kernel_arguments, out, info)
         if status:
             self.forces.raise_status(status, info)

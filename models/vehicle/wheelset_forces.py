@@ -68,6 +68,7 @@ from scipy.interpolate import PchipInterpolator
 
 from railopt.models.bifurcation.integration import ModelLimit
 from railopt.models.contact.saturation import SPIN_MOMENT_CHOICES
+from railopt.models.kernels import c_array
 from railopt.models.validation import number
 from railopt.models.vehicle import wheelset_kernel as kernel
 from railopt.models.vehicle.wheelrail import Creep, WheelRail
@@ -171,7 +172,7 @@ class TabulatedGeometry:
     def __post_init__(self) -> None:
         if self.kind not in ("linear", "pchip"):
             raise ValueError(f"kind: 'linear' or 'pchip', got {self.kind!r}")
-        y = np.ascontiguousarray(self.y, dtype=float)
+        y = c_array(self.y)
         stacked = np.concatenate([self.radius, self.angle, self.lateral_arm, self.vertical_arm])  # (8, n)
         if self.kind == "pchip":  # scipy's coefficients (4, n - 1, 8); the kernel evaluates the cubics
             coef = PchipInterpolator(y, stacked, axis=1).c
@@ -180,7 +181,7 @@ class TabulatedGeometry:
             coef[2] = (np.diff(stacked, axis=1) / np.diff(y)).T
             coef[3] = stacked[:, :-1].T
         object.__setattr__(self, "_breaks", y)
-        object.__setattr__(self, "_coef", np.ascontiguousarray(coef, dtype=float))
+        object.__setattr__(self, "_coef", c_array(coef))
 
     @classmethod
     def from_table(cls, table: object, source: str = "contact table", kind: str = "linear") -> TabulatedGeometry:
@@ -228,8 +229,24 @@ class TabulatedGeometry:
 ContactGeometry = ConicalGeometry | TabulatedGeometry
 
 
-def _shifts(y: object) -> np.ndarray:
-    return np.ascontiguousarray(np.atleast_1d(np.asarray(y, dtype=float)).reshape(-1))
+def _shifts(y: object, name: str = "y") -> np.ndarray:
+    """One value per wheelset: a scalar or a 1-D array, as the kernels' writeable C array."""
+    y = np.atleast_1d(np.asarray(y, dtype=float))
+    if y.ndim != 1:
+        raise ValueError(f"{name}: one value per wheelset (a scalar or a 1-D array), got shape {y.shape}")
+    return c_array(y)
+
+
+def forward_speed(speed: object) -> float:
+    """The forward speed (m/s) as a float for the kernels (which check that it is positive and finite).
+
+    Raises
+    ------
+    ValueError
+        What is not a real number (a string, an array, a bool)."""
+    if isinstance(speed, bool) or not isinstance(speed, int | float | np.integer | np.floating):
+        raise ValueError(f"speed: forward speed must be a positive finite number of m/s, got {speed!r}")
+    return float(speed)
 
 
 # ---------------------------------------------------------------------------------------------------- creep laws
@@ -305,9 +322,11 @@ def _creep_forces(law: CreepLaw, creep: Creep, xi_x, xi_y, xi_sp, N, N0) -> tupl
     params[kernel.P_F11:kernel.P_F33 + 1] = (creep.f11, creep.f22, creep.f23, creep.f33)
     law.parameters(params)
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (xi_x, xi_y, xi_sp, N)))
-    flat = [np.ascontiguousarray(a).reshape(-1) for a in arrays]
+    flat = [c_array(a.reshape(-1)) for a in arrays]
     out = np.empty((3, flat[0].size))
     kernel.creep_forces(params, *flat, float(N0), out)
+    if arrays[0].ndim == 0:
+        return tuple(float(out[i, 0]) for i in range(3))
     return tuple(out[i].reshape(arrays[0].shape) for i in range(3))
 
 
@@ -402,7 +421,7 @@ class WheelsetForces:
     flange: FlangeSpring | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.geometry, ConicalGeometry | TabulatedGeometry):
+        if type(self.geometry) not in (ConicalGeometry, TabulatedGeometry):  # a subclass's overrides: unread
             raise ValueError("geometry: a ConicalGeometry or TabulatedGeometry (the geometries the compiled forces "
                              f"know), got {type(self.geometry).__name__}")
         if not isinstance(self.creep, Creep):
@@ -410,7 +429,7 @@ class WheelsetForces:
         object.__setattr__(self, "axle_load", number("axle_load", self.axle_load, positive=True))
         if self.plane not in ("contact", "track"):
             raise ValueError(f"plane: 'contact' or 'track', got {self.plane!r}")
-        if not isinstance(self.creep_law, LinearCreepLaw | SaturatedCreepLaw):
+        if type(self.creep_law) not in (LinearCreepLaw, SaturatedCreepLaw):
             raise ValueError("creep_law: a LinearCreepLaw or SaturatedCreepLaw (the laws the compiled forces know), "
                              f"got {type(self.creep_law).__name__}")
         params = np.zeros(kernel.N_PARAMS)
@@ -440,14 +459,19 @@ class WheelsetForces:
         Raises
         ------
         ValueError
-            A non-positive speed; a shift outside the table (naming it); normal loads that do not converge.
+            A non-positive speed; a shift outside the table (naming it); a state or normal loads that are not finite;
+        normal loads that do not converge.
         WheelLift
             A wheel's normal load reached zero (a ValueError too).
         """
         if status == kernel.OK:
             return
         if status == kernel.BAD_SPEED:
-            raise ValueError(f"speed: forward speed must be a positive finite number of m/s, got {info[0]!r}")
+            raise ValueError(f"speed: forward speed must be a positive finite number of m/s, got {float(info[0])!r}")
+        if status == kernel.NOT_FINITE:
+            k = int(info[0])
+            what = f"wheelset {k}'s state (y, yaw or a rate)" if k >= 0 else f"wheelset {-1 - k}'s normal loads"
+            raise ValueError(f"state: {what} is not finite (NaN or infinite): the forces are not defined there")
         if status == kernel.OUTSIDE_TABLE:
             raise self.geometry.outside(float(info[0]))
         if status == kernel.WHEEL_LIFT:
@@ -457,17 +481,19 @@ class WheelsetForces:
                          "passes")
 
     def _run(self, y, yaw, dy, droll, dyaw, du, dpitch, speed: float) -> tuple[np.ndarray, np.ndarray]:
+        names = ("y", "yaw", "dy", "droll", "dyaw", "du", "dpitch")
+        values = [_shifts(a, n) for a, n in zip((y, yaw, dy, droll, dyaw, du, dpitch), names, strict=True)]
         try:
-            args = [np.ascontiguousarray(a) for a in np.broadcast_arrays(
-                *(_shifts(a) for a in (y, yaw, dy, droll, dyaw, du, dpitch)))]
+            args = [c_array(a) for a in np.broadcast_arrays(*values)]
         except ValueError:
-            raise ValueError("y, yaw, dy, droll, dyaw, du, dpitch: one value per wheelset each (or one for all), "
-                             "sizes differ") from None
+            raise ValueError(f"{', '.join(names)}: one value per wheelset each (or one for all), sizes "
+                             f"{[a.size for a in values]} differ") from None
         k = args[0].size
         state = np.empty((kernel.N_STATE, 2, k))
         gen = np.empty((len(FORCE_ROWS), k))
         info = np.zeros(2)
-        self.raise_status(kernel.wheelset_forces(*args, float(speed), *self._kernel_args, state, gen, info), info)
+        status = kernel.wheelset_forces(*args, forward_speed(speed), *self._kernel_args, state, gen, info)
+        self.raise_status(status, info)
         return state, gen
 
     def evaluate(self, y, yaw, dy, droll, dyaw, du, dpitch, speed: float) -> WheelsetContactState:
@@ -563,6 +589,7 @@ __all__ = [
     "WheelLift",
     "WheelsetContactState",
     "WheelsetForces",
+    "forward_speed",
     "linear_model_forces",
     "profile_forces",
 ]

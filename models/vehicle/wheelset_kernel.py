@@ -16,13 +16,14 @@ nothing else computes the forces.  What lives here, each written once:
   side, and :func:`vehicle_jacobian`, its Jacobian by central differences.
 
 Why compiled: the forces act on two wheels of one or two wheelsets, arrays of 2–4 numbers, so numpy spent its
-time in per-call overhead (about 650 µs a right-hand side with the saturated law's load iteration, against a few
+time in per-call overhead (260–650 µs a right-hand side with the saturated law's load iteration, against a few
 µs here); a hunting ramp or a continuation evaluates it millions of times.
 
 Parameters travel as one float vector (indices ``P_*`` below) and a table (breakpoints, cubic coefficients) so
 that each kernel has one compiled signature; errors come back as a status code (``OK``, ``BAD_SPEED``,
-``OUTSIDE_TABLE``, ``WHEEL_LIFT``, ``NO_CONVERGENCE``) with the numbers the message needs in ``info``, and the
-Python callers raise them (:func:`~railopt.models.vehicle.wheelset_forces.raise_status`).
+``OUTSIDE_TABLE``, ``WHEEL_LIFT``, ``NO_CONVERGENCE``, ``NOT_FINITE``) with the numbers the message needs in
+``info``, and the Python callers raise them
+(:meth:`~railopt.models.vehicle.wheelset_forces.WheelsetForces.raise_status`).
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ S_XI_X, S_XI_Y, S_XI_SP, S_FX, S_FY, S_MZ, S_N, S_Q, S_Y = range(4, 13)
 N_STATE = 13
 
 # ---- status codes
-OK, BAD_SPEED, OUTSIDE_TABLE, WHEEL_LIFT, NO_CONVERGENCE = range(5)
+OK, BAD_SPEED, OUTSIDE_TABLE, WHEEL_LIFT, NO_CONVERGENCE, NOT_FINITE = range(6)
 
 MAX_PASSES = 50  # normal-load passes with a load-dependent law
 LOAD_TOLERANCE = 1e-10  # |ΔN| ≤ LOAD_TOLERANCE · W ends them
@@ -135,12 +136,18 @@ def wheelset_forces(y: np.ndarray, yaw: np.ndarray, dy: np.ndarray, droll: np.nd
     Inputs (K,): lateral shift y relative to the rail (m), yaw (rad), and the rates of v, α, γ, u, β; ``speed``
     S (m/s).  The normal loads of all K wheelsets are iterated together until the largest change is at most
     ``LOAD_TOLERANCE · W`` (one pass with the linear law); the forces are those of the last pass's creep forces
-    and the loads that balance them.  Returns a status; ``info`` gets the offending numbers: the largest |y|
-    outside the table, or the lowest load and its wheelset's y."""
+    and the loads that balance them.  Returns a status; ``info`` gets the offending numbers: the speed, the
+    largest |y| outside the table, the lowest load and its wheelset's y, or (``NOT_FINITE``) k ≥ 0 for wheelset
+    k's state, −1 − k for its normal loads."""
     K = y.size
     if not (speed > 0.0 and math.isfinite(speed)):
         info[0] = speed
         return BAD_SPEED
+    for k in range(K):  # a NaN would pass every comparison below unnoticed (max(0, nan) is 0 in numba)
+        if not (math.isfinite(y[k]) and math.isfinite(yaw[k]) and math.isfinite(dy[k]) and math.isfinite(droll[k])
+                and math.isfinite(dyaw[k]) and math.isfinite(du[k]) and math.isfinite(dpitch[k])):
+            info[0] = k
+            return NOT_FINITE
     r0, W = params[P_R0], params[P_W]
     if params[P_GEOMETRY] == 0.0:
         conical_points(y, params, state)
@@ -208,9 +215,12 @@ def wheelset_forces(y: np.ndarray, yaw: np.ndarray, dy: np.ndarray, droll: np.nd
         lowest = np.inf
         at = 0
         for k in range(K):
-            m = min(state[S_N, 0, k], state[S_N, 1, k])
-            if m < lowest:
-                lowest, at = m, k
+            for side in range(2):
+                if not math.isfinite(state[S_N, side, k]):  # e.g. a singular balance: not a converged load
+                    info[0] = -1.0 - k
+                    return NOT_FINITE
+                if state[S_N, side, k] < lowest:
+                    lowest, at = state[S_N, side, k], k
         if lowest <= 0.0:
             info[0], info[1] = lowest, y[at]
             return WHEEL_LIFT
@@ -315,6 +325,7 @@ def vehicle_jacobian(x: np.ndarray, speed: float, step: float, MK: np.ndarray, M
 
 __all__ = [
     "BAD_SPEED",
+    "NOT_FINITE",
     "NO_CONVERGENCE",
     "OK",
     "OUTSIDE_TABLE",

@@ -156,3 +156,65 @@ def test_errors_of_the_compiled_paths_name_their_cause() -> None:
         WheelsetForces(Cone(), Creep(1e7, 1e7), 1e5)
     with pytest.raises(ValueError, match="creep_law: a LinearCreepLaw or SaturatedCreepLaw.*got Law"):
         WheelsetForces(ConicalGeometry(0.2, 0.46, 0.75), Creep(1e7, 1e7), 1e5, Law())
+
+
+@pytest.mark.parametrize("law", [LinearCreepLaw(), SaturatedCreepLaw(0.3)])
+def test_a_state_that_is_not_finite_is_an_error_not_nan_forces(law) -> None:
+    """A NaN passes every comparison of the normal-load iteration unnoticed (numba's max(0, nan) is 0): the kernel
+    refuses NaN or infinite states by name instead of returning NaN forces or a 'converged' load."""
+    forces = WheelsetForces(ConicalGeometry(0.2, 0.46, 0.75, theta0=0.03, epsilon=0.3), Creep(1e7, 1e7), 1e5, law)
+    good = [1e-3, 0.0, 0.01, 0.0, 0.0, 0.0, 0.0]
+    assert np.all(np.isfinite(forces.generalized_forces(*good, speed=30.0)))
+    for i in range(7):
+        for bad in (np.nan, np.inf):
+            args = list(good)
+            args[i] = [0.0, bad]  # the second of two wheelsets
+            with pytest.raises(ValueError, match=r"state: wheelset 1's state \(y, yaw or a rate\) is not finite"):
+                forces.generalized_forces(*args, speed=30.0)
+    model = profile_vehicle(load_vehicle(WHEELSET))
+    x = np.zeros(2 * model.n_dof)
+    x[model.n_dof] = np.nan  # a rate
+    for call in (lambda: model.rhs(0.0, x, 40.0), lambda: model.jacobian(x, 40.0)):
+        with pytest.raises(ValueError, match="is not finite"):
+            call()
+
+
+def test_inputs_the_kernels_do_not_take_are_refused_or_normalised() -> None:
+    """Subclasses of the known geometries and laws are refused (the kernels would not read their overrides); a
+    speed that is not a number and 2-D wheelset inputs are refused; read-only or strided states give the same
+    values through the one compiled signature."""
+    from dataclasses import dataclass
+
+    from railopt.models.vehicle import wheelset_kernel
+
+    @dataclass(frozen=True)
+    class HalfFriction(SaturatedCreepLaw):
+        def __call__(self, *args):
+            return tuple(0.5 * v for v in super().__call__(*args))
+
+    class MyCone(ConicalGeometry):
+        pass
+
+    with pytest.raises(ValueError, match="creep_law: .*got HalfFriction"):
+        WheelsetForces(ConicalGeometry(0.2, 0.46, 0.75), Creep(1e7, 1e7), 1e5, HalfFriction(0.3))
+    with pytest.raises(ValueError, match="geometry: .*got MyCone"):
+        WheelsetForces(MyCone(0.2, 0.46, 0.75), Creep(1e7, 1e7), 1e5)
+    forces = WheelsetForces(ConicalGeometry(0.2, 0.46, 0.75), Creep(1e7, 1e7), 1e5, SaturatedCreepLaw(0.3))
+    for speed in ("30", np.array([30.0]), True):
+        with pytest.raises(ValueError, match="speed: forward speed must be a positive finite number"):
+            forces.generalized_forces(1e-3, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, speed=speed)
+    with pytest.raises(ValueError, match=r"speed: .* got -1\.0$"):
+        forces.generalized_forces(1e-3, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, speed=-1)
+    with pytest.raises(ValueError, match=r"y: one value per wheelset .* shape \(2, 3\)"):
+        forces.generalized_forces(np.full((2, 3), 1e-3), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, speed=30.0)
+    model = profile_vehicle(load_vehicle(WHEELSET))
+    X = 1e-3 * np.random.default_rng(4).standard_normal((2 * model.n_dof, 3))
+    x = np.ascontiguousarray(X[:, 1])
+    expected_rhs, expected_jac = model.rhs(0.0, x, 40.0), model.jacobian(x, 40.0)
+    frozen = x.copy()
+    frozen.flags.writeable = False
+    for state in (frozen, X[:, 1]):  # read-only; a strided column
+        np.testing.assert_array_equal(model.rhs(0.0, state, 40.0), expected_rhs)
+        np.testing.assert_array_equal(model.jacobian(state, 40.0), expected_jac)
+    assert len(wheelset_kernel.vehicle_rhs.signatures) == 1
+    assert len(wheelset_kernel.vehicle_jacobian.signatures) == 1
