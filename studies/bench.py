@@ -18,7 +18,8 @@
 6. Exact certified U against python-control's ``linfnorm`` (SLICOT AB13DD) on the same chains without delays
    (skipped with a note when the optional ``bench`` extra is not installed); import + first certified U in a
    fresh process with the compiled kernels' cache cold and warm; the cab model and the full lateral
-   model (6 delayed axle inputs) against the floor.
+   model (6 delayed axle inputs) against the floor; a constrained flagship start against the same starts with
+   the code of an earlier commit (:mod:`.bench_baseline`, not in ``--quick``).
 7. Stability constraints with gradients against one eig(G) per speed; the random-response RMS by quadrature
    against the modal Lyapunov covariance at equal accuracy.
 8. The nonlinear hunting analysis (:mod:`.bench_nonlinear`): seconds per simulated second of the nonlinear coach
@@ -49,6 +50,7 @@ from railopt.models.tmd import nishihara_asami
 from railopt.models.units import INCH, RAD_PER_HZ
 from railopt.models.vehicle import load_vehicle
 from railopt.studies.adapter import response_target
+from railopt.studies.bench_baseline import baseline_row
 from railopt.studies.bench_nonlinear import nonlinear_rows
 from railopt.studies.bench_stability import critical_speed_rows, stacked_rows_row
 from railopt.studies.config import load_study
@@ -743,6 +745,8 @@ def _run(out: Path, workers: int, quick: bool) -> pd.DataFrame:
 
     # 6. the flagship cab model: U(x) vs the floor; SLSQP with analytic vs finite-difference gradients ------
     rows += _cab_rows(repeat)
+    if not quick:  # ~50 s: the baseline commit's code from the checkout's history, in fresh processes
+        rows.append(baseline_row())
 
     # 7. stability constraints with gradients; random response by quadrature vs Lyapunov ------------------------
     rows.append(_stability_row(max(repeat // 4, 5)))
