@@ -424,7 +424,7 @@ def _dispatch_rows(quick: bool, ceiling: float, workers: int) -> list[dict]:
 
 def _throughput(problem: MinimaxProblem, objective: str, workers: int, sizes: tuple[int, ...]) -> list[dict]:
     """Starts per second of ``problem``'s multistart, serial against a LocalCluster of ``workers``, at each campaign
-    size: for the TMD a short campaign (dask's fixed cost per campaign and per task weighs on ~0.8 s of work) and a
+    size: for the TMD a short campaign (dask's fixed cost per campaign and per task weighs on ~1 s of work) and a
     long one (the throughput a campaign of many starts gets); ``objective`` names the problem in the rows."""
     serial, runs = {}, {}
     multistart(problem, 2 * workers, seed=99)  # warm this process (first calls, caches), as the workers below

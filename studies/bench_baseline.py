@@ -6,8 +6,9 @@ today is commit :data:`BASELINE_COMMIT`.  The bench takes that commit's ``railop
 temporary folder, and runs the same constrained multistart of the flagship (SLSQP, exact objective, the stability
 rows; ``BASELINE_STARTS`` starts from the same Sobol seed, after two warm-up starts, one BLAS thread) in fresh
 processes, old and current alternating, :data:`BASELINE_ROUNDS` rounds; the row gives the median time of each and
-checks that both found the same U at every start (the same problem).  Without git or that commit (an installed
-package, a shallow clone) the row says it was skipped.
+checks that both found the same U at every start (the same problem: within :data:`SAME_U`, else the row is
+not a result).  Without git or that commit (an installed package, a shallow clone) the row says it was skipped; a
+run that fails makes the row "failed, not a result", never the whole bench.
 """
 
 from __future__ import annotations
@@ -23,15 +24,16 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-BASELINE_COMMIT = "54b5f8c"
+BASELINE_COMMIT = "54b5f8ccf59cf7a185d350edbff1300fbdcc0381"
 """The commit whose constrained flagship start is issue 25's "today's time"."""
 BASELINE_STARTS = 6
 BASELINE_ROUNDS = 3
+SAME_U = 1e-8  # the two codes' U at every start agree within this (relative), or the row is not a result
 
 HERMETIC = """
 import sys
 # the editable install's finder would hand a module the old tree lacks over from the current checkout
-sys.meta_path[:] = [f for f in sys.meta_path if not getattr(f, "__module__", "").startswith("__editable__")]
+sys.meta_path[:] = [f for f in sys.meta_path if not (getattr(f, "__module__", None) or "").startswith("__editable__")]
 """
 """Prepended to the baseline's process: only the laid-out commit's code is importable as ``railopt``."""
 
@@ -50,7 +52,8 @@ with threadpool_limits(1):
     t = time.perf_counter()
     table = multistart(problem, int(sys.argv[2]), seed=1).sort_values("start_id")
     seconds = time.perf_counter() - t
-print(json.dumps({"railopt": railopt.__file__, "seconds": seconds, "U": table["value"].tolist()}))
+print(json.dumps({"railopt": railopt.__file__, "seconds": seconds, "U": table["value"].tolist(),
+                  "evaluations": table["evaluations"].tolist()}))
 """
 
 
@@ -74,8 +77,12 @@ def _start_times(pythonpath: Path | None, study: Path, expected: Path) -> dict:
     if pythonpath is not None:
         env["PYTHONPATH"] = str(pythonpath)
     code = (HERMETIC if pythonpath is not None else "") + _RUN
-    done = subprocess.run([sys.executable, "-c", code, str(study), str(BASELINE_STARTS)], env=env,
-                          cwd=str(study.parent), capture_output=True, text=True, timeout=900, check=True)
+    # -P: the working folder stays off sys.path (the studies folder's modules must not become top-level names)
+    done = subprocess.run([sys.executable, "-P", "-c", code, str(study), str(BASELINE_STARTS)], env=env,
+                          cwd=str(study.parent), capture_output=True, text=True, timeout=900)
+    if done.returncode != 0:
+        tail = " | ".join(done.stderr.strip().splitlines()[-3:])
+        raise RuntimeError(f"exit status {done.returncode}: {tail}")
     out = json.loads(done.stdout.strip().splitlines()[-1])
     if not Path(out["railopt"]).resolve().is_relative_to(expected.resolve()):
         raise RuntimeError(f"the run imported railopt from {out['railopt']}, not from {expected}")
@@ -93,25 +100,44 @@ def baseline_row() -> dict:
     with tempfile.TemporaryDirectory(prefix="railopt-baseline-") as tmp:
         try:
             old_path = _old_package(Path(tmp))
-        except (subprocess.CalledProcessError, OSError, subprocess.TimeoutExpired) as exc:
+        except subprocess.CalledProcessError as exc:
             return {"benchmark": name, "note": f"skipped: commit {BASELINE_COMMIT} is not in this checkout's history "
-                                               f"({type(exc).__name__}; a shallow clone or an installed package)"}
+                                               f"(git: {(exc.stderr or b'').decode(errors='replace').strip()[:120]}; "
+                                               "a shallow clone or an installed package)"}
+        except (OSError, subprocess.TimeoutExpired) as exc:
+            return {"benchmark": name, "note": f"skipped: the baseline could not be laid out ({type(exc).__name__}: "
+                                               f"{exc})"}
         old_study = old_path / "railopt" / "studies" / "cab_lateral_minimax.toml"
         new_study = ROOT / "studies" / "cab_lateral_minimax.toml"
         old, new = [], []
-        for _ in range(BASELINE_ROUNDS):
-            old.append(_start_times(old_path, old_study, old_path))
-            new.append(_start_times(None, new_study, ROOT))
+        try:
+            for _ in range(BASELINE_ROUNDS):
+                old.append(_start_times(old_path, old_study, old_path))
+                new.append(_start_times(None, new_study, ROOT))
+        except (RuntimeError, ValueError, KeyError, IndexError, subprocess.TimeoutExpired) as exc:
+            return {"benchmark": name, "ratio": float("nan"),
+                    "note": f"failed, not a result: {'the baseline' if len(old) == len(new) else 'the current code'} "
+                            f"run ({type(exc).__name__}: {exc})"}
     t_old = float(np.median([r["seconds"] for r in old]))
     t_new = float(np.median([r["seconds"] for r in new]))
-    u_old, u_new = np.array(old[0]["U"]), np.array(new[0]["U"])
+    u_old, u_new = np.array(old[0]["U"], dtype=float), np.array(new[0]["U"], dtype=float)
+    runs = (", ".join(f"{r['seconds']:.2f}" for r in old) + " s then, "
+            + ", ".join(f"{r['seconds']:.2f}" for r in new) + " s now")
+    if u_old.shape != u_new.shape or not (np.all(np.isfinite(u_old)) and np.all(np.isfinite(u_new))):
+        return {"benchmark": name, "ratio": float("nan"),
+                "note": f"not a result: the two runs did not solve the same starts (U {u_old.tolist()} then, "
+                        f"{u_new.tolist()} now); {runs}"}
     diff = float(np.max(np.abs(u_new - u_old) / np.abs(u_old)))
+    if diff > SAME_U:
+        return {"benchmark": name, "ratio": float("nan"),
+                "note": f"not a result: U differs by {diff:.1e} > {SAME_U:g} between the two codes (not the same "
+                        f"problem); {runs}"}
+    evaluations = f"evaluations {sum(old[0]['evaluations'])} then, {sum(new[0]['evaluations'])} now"
     return {"benchmark": name, "ours_s": t_new / BASELINE_STARTS, "reference_s": t_old / BASELINE_STARTS,
-            "reference": f"the same starts with the code of commit {BASELINE_COMMIT} (issue 25's \"today\")",
+            "reference": f"the same starts with the code of commit {BASELINE_COMMIT[:7]} (issue 25's \"today\")",
             "ratio": t_new / t_old,
-            "note": f"goal ≤ 0.5×; max |ΔU|/U over the starts {diff:.1e} (the same problem); runs "
-                    + ", ".join(f"{r['seconds']:.2f}" for r in old) + " s then, "
-                    + ", ".join(f"{r['seconds']:.2f}" for r in new) + " s now"}
+            "note": f"goal ≤ 0.5×; max |ΔU|/U over the starts {diff:.1e} (the same problem; {evaluations}); "
+                    f"runs {runs}"}
 
 
 __all__ = ["BASELINE_COMMIT", "HERMETIC", "baseline_row"]

@@ -225,3 +225,35 @@ continuation = false
     assert np.allclose(indicators["peak_y_mm"], steady["amplitude_mm"], rtol=3e-3)  # a symmetric cycle
     assert (out / "bifurcation_wheelset.png").is_file()
     assert "Verdict: no stable hunting cycle up to 40 m/s." in (out / "summary.md").read_text()
+
+
+@pytest.mark.parametrize("workers, warmed", [(2, True), (None, True), (0, False)])
+def test_a_campaign_with_the_check_warms_the_wheel_rail_kernels_before_its_cluster(monkeypatch, tmp_path, workers,
+                                                                                   warmed):
+    """The check runs on the workers: the driver compiles (or loads) the wheel/rail kernels before the cluster
+    starts, so that cold workers do not each compile them; a serial run does not need it.  Without the check no
+    warm-up of these kernels."""
+    from railopt.studies.kind import StudyContext
+    from railopt.studies.kinds.campaign import run
+
+    events = []
+
+    class Started(Exception):
+        pass
+
+    def cluster(context):
+        events.append("cluster")
+        raise Started
+
+    monkeypatch.setattr("railopt.studies.kernel_warmup.warm_nonlinear_kernels", lambda show: events.append("warm"))
+    monkeypatch.setattr(run, "dask_context", cluster)
+    context = StudyContext(store_dir=tmp_path, workers=workers)
+    with pytest.raises(Started):
+        run.compute(CampaignStudyConfig.model_validate(_raw()), context)
+    assert events == (["warm", "cluster"] if warmed else ["cluster"])
+    events.clear()
+    without = _raw(design={**RAW["design"], "checks": ["hunting"]})
+    without.pop("nonlinear_hunting")
+    with pytest.raises(Started):
+        run.compute(CampaignStudyConfig.model_validate(without), context)
+    assert events == ["cluster"]
