@@ -452,14 +452,10 @@ def _median_run(run: Callable[[], object], count: int | None = None) -> tuple[fl
     """Wall time of ``run()``: the median of ``count`` runs, or (``count`` None) of 3 when the first takes under
     :data:`SHORT_RUN_S` (a one-second campaign varies by several per cent run to run), else that one; returns
     the time and the number of runs."""
-    times = []
-    while True:
-        t = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - t)
-        wanted = count if count is not None else (3 if times[0] < SHORT_RUN_S else 1)
-        if len(times) >= wanted:
-            return float(np.median(times)), len(times)
+    first = _median_time(run, 1)
+    count = count if count is not None else (3 if first < SHORT_RUN_S else 1)
+    times = [first] + [_median_time(run, 1) for _ in range(count - 1)]
+    return float(np.median(times)), count
 
 
 def _spin(seconds: float) -> float:

@@ -32,8 +32,10 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numba import njit
 
 from railopt.models.contact.creep import CreepCoefficients
+from railopt.models.kernels import JIT, c_array
 from railopt.models.validation import real_array
 
 SpinMoment = Literal["scaled", "linear"]
@@ -63,12 +65,34 @@ class SaturatedCreepForces:
     ratio: np.ndarray
 
 
+@njit(**JIT)
+def she_ratio(r: float) -> float:
+    """The cubic of :func:`she_force_ratio` at one r ≥ 0, compiled: the one implementation, which the compiled
+    wheel/rail forces (:mod:`railopt.models.vehicle.wheelset_kernel`) call too."""
+    if r <= 3.0:
+        return r * (1.0 - r / 3.0 + r * r / 27.0)
+    return 1.0
+
+
+@njit(**JIT)
+def _she_ratios(r: np.ndarray, out: np.ndarray) -> None:
+    for j in range(r.size):
+        out[j] = she_ratio(r[j])
+
+
 def she_force_ratio(r: np.ndarray | float) -> np.ndarray:
-    """Saturated resultant over μN as a function of r = F'/(μN) ≥ 0: r − r²/3 + r³/27 (r ≤ 3), else 1."""
+    """Saturated resultant over μN as a function of r = F'/(μN) ≥ 0: r − r²/3 + r³/27 (r ≤ 3), else 1.
+
+    Raises
+    ------
+    ValueError
+        A negative r."""
     r = np.asarray(r, dtype=float)
     if np.any(r < 0.0):
         raise ValueError("r: the linear-force ratio F'/(μN) must be >= 0")
-    return np.where(r <= 3.0, r * (1.0 - r / 3.0 + r * r / 27.0), 1.0)
+    out = np.empty(r.size)
+    _she_ratios(c_array(r.reshape(-1)), out)
+    return out.reshape(r.shape)
 
 
 def _epsilon(r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -205,6 +229,7 @@ __all__ = [
     "SaturatedCreepForces",
     "SpinMoment",
     "she_force_ratio",
+    "she_ratio",
     "shen_hedrick_elkins",
     "shen_hedrick_elkins_jacobian",
 ]

@@ -104,6 +104,13 @@ class NonlinearVehicle:
             raise ValueError(f"unknown state {name!r}; valid: {', '.join(names)}")
         return names.index(name)
 
+    def _kernel_state(self, x: np.ndarray) -> np.ndarray:
+        """x as the kernels' writeable C array of shape (2n,); the shape error of :meth:`_split` otherwise."""
+        x = np.asarray(x, dtype=float)
+        if x.shape != (2 * self.n_dof,):
+            self._split(x)  # raises the shape error
+        return c_array(x)
+
     def _split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         x = np.asarray(x, dtype=float)
         n = self.n_dof
@@ -137,15 +144,12 @@ class NonlinearVehicle:
         ValueError
             x of the wrong shape, and the errors of :meth:`WheelsetForces.evaluate` (a wheel that lifts is a
             :class:`~railopt.models.vehicle.wheelset_forces.WheelLift`)."""
-        x = np.asarray(x, dtype=float)
-        if x.shape != (2 * self.n_dof,):
-            self._split(x)  # the shape error
+        x = self._kernel_state(x)
         out = np.empty(x.size)
         info = np.zeros(2)
-        status = vehicle_rhs(c_array(x), forward_speed(speed), self._MK, self._MC, self._MB, self._T,
+        status = vehicle_rhs(x, forward_speed(speed), self._MK, self._MC, self._MB, self._T,
                              *self.forces.kernel_arguments, out, info)
-        if status:
-            self.forces.raise_status(status, info)
+        self.forces.raise_status(status, info)
         return out
 
     def jacobian(self, x: np.ndarray, speed: float, step: float = JACOBIAN_STEP) -> np.ndarray:
@@ -160,15 +164,12 @@ class NonlinearVehicle:
         ------
         ValueError
             As :meth:`rhs`, for any of the perturbed states."""
-        x = np.asarray(x, dtype=float)
-        if x.shape != (2 * self.n_dof,):
-            self._split(x)  # the shape error
+        x = self._kernel_state(x)
         out = np.empty((x.size, x.size))
         info = np.zeros(2)
-        status = vehicle_jacobian(c_array(x), forward_speed(speed), float(step), self._MK, self._MC, self._MB,
-                                  self._T, *self.forces.kernel_arguments, out, info)
-        if status:
-            self.forces.raise_status(status, info)
+        status = vehicle_jacobian(x, forward_speed(speed), float(step), self._MK, self._MC, self._MB, self._T,
+                                  *self.forces.kernel_arguments, out, info)
+        self.forces.raise_status(status, info)
         return out
 
 

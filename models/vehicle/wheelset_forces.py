@@ -421,7 +421,7 @@ class WheelsetForces:
     flange: FlangeSpring | None = None
 
     def __post_init__(self) -> None:
-        if type(self.geometry) not in (ConicalGeometry, TabulatedGeometry):  # a subclass's overrides: unread
+        if type(self.geometry) not in ContactGeometry.__args__:  # not a subclass either: its overrides go unread
             raise ValueError("geometry: a ConicalGeometry or TabulatedGeometry (the geometries the compiled forces "
                              f"know), got {type(self.geometry).__name__}")
         if not isinstance(self.creep, Creep):
@@ -429,7 +429,7 @@ class WheelsetForces:
         object.__setattr__(self, "axle_load", number("axle_load", self.axle_load, positive=True))
         if self.plane not in ("contact", "track"):
             raise ValueError(f"plane: 'contact' or 'track', got {self.plane!r}")
-        if type(self.creep_law) not in (LinearCreepLaw, SaturatedCreepLaw):
+        if type(self.creep_law) not in CreepLaw.__args__:
             raise ValueError("creep_law: a LinearCreepLaw or SaturatedCreepLaw (the laws the compiled forces know), "
                              f"got {type(self.creep_law).__name__}")
         params = np.zeros(kernel.N_PARAMS)

@@ -33,7 +33,8 @@ import math
 import numpy as np
 from numba import njit
 
-JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
+from railopt.models.contact.saturation import she_ratio
+from railopt.models.kernels import JIT
 
 # ---- the parameter vector: contact, creep law, plane, flange, geometry
 P_R0, P_W, P_F11, P_F22, P_F23, P_F33 = range(6)
@@ -88,21 +89,14 @@ def table_points(y: np.ndarray, breaks: np.ndarray, coef: np.ndarray, out: np.nd
 
 
 @njit(**JIT)
-def she_ratio(r: float) -> float:
-    """Shen–Hedrick–Elkins: saturated resultant over μN at r = F'/(μN) ≥ 0, r − r²/3 + r³/27 (r ≤ 3), else 1."""
-    if r <= 3.0:
-        return r * (1.0 - r / 3.0 + r * r / 27.0)
-    return 1.0
-
-
-@njit(**JIT)
 def creep_law(params: np.ndarray, xi_x: float, xi_y: float, xi_sp: float, N: float,
               N0: float) -> tuple[float, float, float]:
     """Creep forces (Fx, Fy, Mz) of one contact (N, N·m) in the sign convention of :mod:`.wheelrail`.
 
     Linear law (4.9): ``Fx = −f11 ξx``, ``Fy = −f22 ξy + f23 ξsp``, ``Mz = −f23 ξy − f33 ξsp``.  Saturated: the
     same with f11, f22 ∝ (N/N0)^(2/3), f23 ∝ N/N0, f33 ∝ (N/N0)^(4/3) (with load scaling), then the forces
-    times ε = she_ratio(r)/r, r = |(Fx, Fy)|/(μN) (the spin moment too when it is scaled)."""
+    times ε = she_ratio(r)/r, r = |(Fx, Fy)|/(μN) (the spin moment too when it is scaled; ``she_ratio`` of
+    :mod:`railopt.models.contact.saturation`)."""
     f11, f22, f23, f33 = params[P_F11], params[P_F22], params[P_F23], params[P_F33]
     if params[P_LAW] == 0.0:
         return -f11 * xi_x, -f22 * xi_y + f23 * xi_sp, -f23 * xi_y - f33 * xi_sp
@@ -333,7 +327,6 @@ __all__ = [
     "conical_points",
     "creep_forces",
     "creep_law",
-    "she_ratio",
     "table_points",
     "vehicle_jacobian",
     "vehicle_rhs",
