@@ -214,11 +214,15 @@ def _railopt(where: str, args: list[str], cwd: Path, produced: set[Path]) -> Non
         assert parsed.workers >= 0, where
 
 
+PYTEST_VALUE_OPTIONS = {"-n", "--numprocesses", "--dist", "--durations", "-k", "-m", "-p", "--timeout"}  # take a value
+
+
 def _setup_command(where: str, argv: list[str], cwd: Path, produced: set[Path]) -> None:
     program = _program(argv[0])
     if program in ("python", "python3") and argv[1:3] in (["-m", "venv"], ["-m", "pytest"]):
-        for path in argv[3 if argv[2] == "pytest" else 4:]:
-            if not path.startswith("-"):
+        args = argv[3 if argv[2] == "pytest" else 4:]
+        for before, path in zip([None, *args], args, strict=False):
+            if not path.startswith("-") and before not in PYTEST_VALUE_OPTIONS:
                 assert (cwd / path.split("::")[0]).exists(), f"{where}: {path}: no such test path"
         return
     if program == "pip" and argv[1:2] == ["install"]:
