@@ -39,7 +39,8 @@ from faults_cli import (
 from railopt.studies.output import publish as publish_module
 from railopt.studies.output.publish import lock_path, publish
 
-N_STARTS = 24  # + the Den Hartog start: ids 0..24; long enough (~2 s) to be killed in the middle
+N_STARTS = 96  # + the Den Hartog start: ids 0..96; ~1.5 s of starts, so that a signal sent once 6 or 8 are stored
+# still finds the run going on a loaded machine (with 24, a run under load had finished before its SIGTERM went)
 IDS = list(range(N_STARTS + 1))
 
 
@@ -147,6 +148,7 @@ def _kill_when(proc: subprocess.Popen, condition, sig: int = signal.SIGKILL) -> 
     landed = wait_until(proc, condition)
     out, err = (None, None) if landed else proc.communicate()
     assert landed, f"the run ended (rc {proc.returncode}) before it could be killed: {err}"
+    assert proc.poll() is None, f"the run ended (rc {proc.returncode}) before the signal went: too few starts left"
     proc.send_signal(sig)
     proc.wait(30)
 
