@@ -268,14 +268,6 @@ def test_a_server_that_is_not_a_scheduler_fails_within_the_timeout(reply: bytes 
         c.close()
 
 
-def _free_port() -> int:
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
 def _start(*args: str) -> subprocess.Popen:
     """A dask process in its own session; it can import this module (the tasks' classes live here)."""
     path = os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")])
@@ -289,22 +281,19 @@ def _stop(proc: subprocess.Popen) -> None:
     proc.wait()
 
 
-def _wait_for_port(port: int, limit: float = 30.0) -> None:
-    end = time.monotonic() + limit
-    while time.monotonic() < end:
-        with socket.socket() as s:
-            if s.connect_ex(("127.0.0.1", port)) == 0:
-                return
-        time.sleep(0.1)
-    raise AssertionError(f"no scheduler on port {port}")
-
-
 @pytest.fixture
-def scheduler():
-    port = _free_port()
-    proc = _start("distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard")
-    _wait_for_port(port)
-    yield f"tcp://127.0.0.1:{port}", proc
+def scheduler(tmp_path: Path):
+    from dask_scheduler import scheduler_address  # here: a dask worker that imports this module has no tests/
+
+    file = tmp_path / "scheduler.json"
+    proc = _start("distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                  "--scheduler-file", str(file))
+    try:
+        address = scheduler_address(file, proc)
+    except AssertionError:
+        _stop(proc)
+        raise
+    yield address, proc
     _stop(proc)
 
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -16,6 +15,7 @@ import pandas as pd
 import pytest
 from dask.distributed import Client
 from dask.utils import parse_timedelta
+from dask_scheduler import scheduler_address
 from faults_cli import (
     STUDY,
     assert_refused,
@@ -103,23 +103,17 @@ def _own_session(*args: str) -> subprocess.Popen:
                             start_new_session=True, env=env())
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.mark.slow
 @pytest.mark.timeout(300)
 def test_a_worker_lost_on_an_external_cluster_is_said_and_timing_records_the_workers(tmp_path):
     """An external cluster of two workers (no nanny: a killed worker stays dead) loses one while the campaign runs:
     the run finishes with every start once, says that the worker left and its tasks were re-run, and ``timing.csv``
     records 2 workers at the start, 1 at the end, 2 at most, 1 lost."""
-    port = _free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    procs = [_own_session("distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
-                          "--no-dashboard")]
+    file = tmp_path / "scheduler.json"
+    procs = [_own_session("distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                          "--no-dashboard", "--scheduler-file", str(file))]
     try:
+        address = scheduler_address(file, procs[0])
         procs += [_own_session("distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
                                "--no-dashboard", "--host", "127.0.0.1") for _ in range(2)]
         with Client(address, timeout=30) as client:
